@@ -1,0 +1,127 @@
+//! Typed errors: what went wrong reading a file, and what is wrong with a mesh.
+//!
+//! Every variant names the offending element so a user can find it; `Display`
+//! gives the one-line message shown by the CLI and the page.
+
+use serde::Serialize;
+use std::fmt;
+
+/// A defect found in a mesh. Vertex indices refer to welded vertices unless a
+/// field says otherwise; face indices refer to the imported triangles in order.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Problem {
+    /// An edge shared by more than two faces.
+    NonManifoldEdge { edge: [u32; 2], faces: Vec<u32> },
+    /// A vertex whose faces form more than one fan (a "bow-tie").
+    NonManifoldVertex { vertex: u32, fans: u32 },
+    /// Two faces share an edge but traverse it in the same direction.
+    InconsistentOrientation { edge: [u32; 2], faces: [u32; 2] },
+    /// A face with (numerically) zero area but three distinct vertices.
+    ZeroAreaFace { face: u32, area: f64 },
+    /// An edge whose two distinct end vertices lie at (numerically) the same point.
+    ZeroLengthEdge { edge: [u32; 2], face: u32 },
+    /// A face that uses the same vertex twice (a collapsed edge).
+    DegenerateFace { face: u32, vertices: [u32; 3] },
+    /// Two faces over the same three vertices.
+    DuplicateFace { faces: [u32; 2] },
+    /// A source vertex that no face uses.
+    UnreferencedVertex { vertex: u32 },
+    /// A vertex coordinate that is NaN or infinite (source vertex index).
+    NonFiniteCoordinate { vertex: u32 },
+    /// A face index that points past the vertex list (source indices).
+    IndexOutOfRange { face: u32, index: u32, vertex_count: u32 },
+}
+
+impl Problem {
+    /// True for defects that make the mesh unusable for parametrization;
+    /// false for those that are only reported (unreferenced vertices are dropped).
+    pub fn is_blocking(&self) -> bool {
+        !matches!(self, Problem::UnreferencedVertex { .. })
+    }
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Problem::NonManifoldEdge { edge, faces } => write!(
+                f,
+                "edge (v{}, v{}) has {} faces ({})",
+                edge[0],
+                edge[1],
+                faces.len(),
+                list("f", faces)
+            ),
+            Problem::NonManifoldVertex { vertex, fans } => {
+                write!(f, "vertex v{vertex} is non-manifold: its faces form {fans} separate fans")
+            }
+            Problem::InconsistentOrientation { edge, faces } => write!(
+                f,
+                "faces f{} and f{} are oriented inconsistently across edge (v{}, v{})",
+                faces[0], faces[1], edge[0], edge[1]
+            ),
+            Problem::ZeroAreaFace { face, area } => write!(f, "face f{face} has zero area ({area:e})"),
+            Problem::ZeroLengthEdge { edge, face } => {
+                write!(f, "edge (v{}, v{}) of face f{face} has zero length", edge[0], edge[1])
+            }
+            Problem::DegenerateFace { face, vertices } => write!(
+                f,
+                "face f{face} is degenerate: it uses a vertex twice (v{}, v{}, v{})",
+                vertices[0], vertices[1], vertices[2]
+            ),
+            Problem::DuplicateFace { faces } => {
+                write!(f, "faces f{} and f{} are duplicates over the same three vertices", faces[0], faces[1])
+            }
+            Problem::UnreferencedVertex { vertex } => write!(f, "vertex v{vertex} is not used by any face"),
+            Problem::NonFiniteCoordinate { vertex } => {
+                write!(f, "vertex v{vertex} has a NaN or infinite coordinate")
+            }
+            Problem::IndexOutOfRange { face, index, vertex_count } => write!(
+                f,
+                "face f{face} refers to vertex {index}, but there are only {vertex_count} vertices"
+            ),
+        }
+    }
+}
+
+fn list(prefix: &str, items: &[u32]) -> String {
+    items.iter().map(|i| format!("{prefix}{i}")).collect::<Vec<_>>().join(", ")
+}
+
+/// Why a file could not be turned into a triangle soup.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ImportError {
+    /// The file name's extension and its first bytes match no supported format.
+    UnknownFormat { name: String },
+    /// The file holds no bytes.
+    Empty { name: String },
+    /// The file parsed but holds no triangle geometry.
+    NoTriangles { name: String },
+    /// The file needs an extension this importer does not support.
+    UnsupportedExtension { extension: String },
+    /// A glTF buffer is missing, e.g. an external `.bin` that was not supplied.
+    MissingBuffer { uri: String },
+    /// The file is malformed or truncated; `detail` says where.
+    Malformed { format: &'static str, detail: String },
+}
+
+impl fmt::Display for ImportError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ImportError::UnknownFormat { name } => {
+                write!(f, "{name}: not a recognised mesh file (expected .glb, .gltf or .obj)")
+            }
+            ImportError::Empty { name } => write!(f, "{name}: the file is empty"),
+            ImportError::NoTriangles { name } => write!(f, "{name}: the file contains no triangle geometry"),
+            ImportError::UnsupportedExtension { extension } => {
+                write!(f, "unsupported glTF extension {extension}: decompress the file first (e.g. gltf-transform)")
+            }
+            ImportError::MissingBuffer { uri } => {
+                write!(f, "glTF buffer \"{uri}\" was not supplied: drop the .gltf together with its .bin")
+            }
+            ImportError::Malformed { format, detail } => write!(f, "malformed {format} file: {detail}"),
+        }
+    }
+}
+
+impl std::error::Error for ImportError {}

@@ -1,0 +1,18 @@
+//! conemap: seamless, feature-aligned UV parametrization with automatic cone
+//! placement, after Myles & Zorin 2013, "Controlled-Distortion Constrained
+//! Global Parametrization".
+//!
+//! Data flows one way:
+//! file bytes → [`io`] (a [`RawMesh`]) → [`mesh`] (a validated [`TriMesh`])
+//! → discrete operators → cone placement → cut and field → parametrization → export.
+
+pub mod error;
+pub mod io;
+pub mod linalg;
+pub mod mesh;
+
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;
+
+pub use error::{ImportError, Problem};
+pub use mesh::{MeshReport, RawMesh, TriMesh};

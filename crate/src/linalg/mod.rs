@@ -1,0 +1,2 @@
+//! Sparse linear algebra: a reusable symmetric (indefinite) factorization on
+//! top of faer (OWNER: linalg helper).
