@@ -10,6 +10,7 @@ pub mod error;
 pub mod io;
 pub mod linalg;
 pub mod mesh;
+pub mod operators;
 
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;

@@ -1,0 +1,129 @@
+//! Assembly of saddle-point (KKT) systems
+//! `K = [[A, Cᵀ], [C, 0]]`, `K [x; λ] = [b; d]`
+//! with `A` (n × n) symmetric positive semi-definite and `C` (m × n) the
+//! constraint rows, and a one-off convenience solve.
+
+use super::cholesky::{LdltSolver, SolveInfo};
+use super::pattern::{SymmetricPattern, Triplet};
+use super::SolveError;
+
+/// An assembled KKT matrix of size `n + m` (primal unknowns first, then one
+/// multiplier per constraint row) on a fixed pattern.
+#[derive(Clone, Debug)]
+pub struct Kkt {
+    /// Number of primal unknowns (size of `A`).
+    pub n: usize,
+    /// Number of constraint rows (rows of `C`).
+    pub m: usize,
+    /// Pattern of `K` (upper triangle).
+    pub pattern: SymmetricPattern,
+    /// Values of `K` in slot order.
+    pub values: Vec<f64>,
+    /// Pivot signs: `+1` for the `n` primal rows, `−1` for the `m` constraint rows.
+    pub signs: Vec<i8>,
+}
+
+/// Maps the triplets of `A` (upper or full, n × n) and `C` (m × n, row =
+/// constraint index) to triplets of `K` (upper triangle).
+fn kkt_triplets(
+    a_triplets: &[Triplet],
+    n: usize,
+    c_triplets: &[Triplet],
+    m: usize,
+) -> Result<Vec<Triplet>, SolveError> {
+    let mut t = Vec::with_capacity(a_triplets.len() + c_triplets.len());
+    for &(r, c, v) in a_triplets {
+        if r >= n || c >= n {
+            return Err(SolveError::IndexOutOfBounds { row: r, col: c, n });
+        }
+        t.push((r, c, v));
+    }
+    for &(r, c, v) in c_triplets {
+        if r >= m || c >= n {
+            return Err(SolveError::IndexOutOfBounds { row: r, col: c, n: m.max(n) });
+        }
+        // C[r, c] sits at K[n + r, c]; store its upper mirror K[c, n + r].
+        t.push((c, n + r, v));
+    }
+    Ok(t)
+}
+
+impl Kkt {
+    /// Assembles `K` from the triplets of `A` (upper triangle or full
+    /// symmetric, duplicates summed) and of `C` (`(constraint, unknown, value)`).
+    pub fn assemble(
+        a_triplets: &[Triplet],
+        n: usize,
+        c_triplets: &[Triplet],
+        m: usize,
+    ) -> Result<Self, SolveError> {
+        let t = kkt_triplets(a_triplets, n, c_triplets, m)?;
+        let (pattern, values) = SymmetricPattern::with_values(n + m, &t)?;
+        let signs = (0..n + m).map(|i| if i < n { 1 } else { -1 }).collect();
+        Ok(Self { n, m, pattern, values, signs })
+    }
+
+    /// Refills the values on the same pattern (entries must be a subset of the
+    /// assembled positions, else [`SolveError::NotInPattern`]).
+    pub fn refill(&mut self, a_triplets: &[Triplet], c_triplets: &[Triplet]) -> Result<(), SolveError> {
+        let t = kkt_triplets(a_triplets, self.n, c_triplets, self.m)?;
+        self.pattern.fill_values(&t, &mut self.values)
+    }
+
+    /// A solver analysed for this pattern and factorized with the current values.
+    pub fn solver(&self) -> Result<LdltSolver, SolveError> {
+        let mut s = LdltSolver::new(&self.pattern, &self.signs)?;
+        s.factorize(&self.values)?;
+        Ok(s)
+    }
+
+    /// Stacks `[b; d]` into one right-hand side of length `n + m`.
+    pub fn rhs(&self, rhs_primal: &[f64], rhs_constraint: &[f64]) -> Result<Vec<f64>, SolveError> {
+        if rhs_primal.len() != self.n {
+            return Err(SolveError::DimensionMismatch {
+                what: "primal right-hand side",
+                expected: self.n,
+                found: rhs_primal.len(),
+            });
+        }
+        if rhs_constraint.len() != self.m {
+            return Err(SolveError::DimensionMismatch {
+                what: "constraint right-hand side",
+                expected: self.m,
+                found: rhs_constraint.len(),
+            });
+        }
+        Ok(rhs_primal.iter().chain(rhs_constraint).copied().collect())
+    }
+}
+
+/// Solution of a KKT system.
+#[derive(Clone, Debug)]
+pub struct KktSolution {
+    /// Primal unknowns (length `n`).
+    pub x: Vec<f64>,
+    /// Lagrange multipliers (length `m`), with the sign convention
+    /// `A x + Cᵀ λ = b`.
+    pub lambda: Vec<f64>,
+    /// Achieved residual of the full system.
+    pub info: SolveInfo,
+}
+
+/// One-off solve of `[[A, Cᵀ], [C, 0]] [x; λ] = [b; d]`: `A` from
+/// `a_triplets` (n × n, upper or full), `C` from `c_triplets` (m × n).
+/// For repeated solves build a [`Kkt`] and keep its [`LdltSolver`].
+pub fn solve_kkt(
+    a_triplets: &[Triplet],
+    n: usize,
+    c_triplets: &[Triplet],
+    m: usize,
+    rhs_primal: &[f64],
+    rhs_constraint: &[f64],
+) -> Result<KktSolution, SolveError> {
+    let kkt = Kkt::assemble(a_triplets, n, c_triplets, m)?;
+    let rhs = kkt.rhs(rhs_primal, rhs_constraint)?;
+    let solver = kkt.solver()?;
+    let (mut x, info) = solver.solve_with_info(&rhs)?;
+    let lambda = x.split_off(n);
+    Ok(KktSolution { x, lambda, info })
+}
