@@ -19,7 +19,8 @@ pub enum Problem {
     InconsistentOrientation { edge: [u32; 2], faces: [u32; 2] },
     /// A face with (numerically) zero area but three distinct vertices.
     ZeroAreaFace { face: u32, area: f64 },
-    /// An edge whose two distinct end vertices lie at (numerically) the same point.
+    /// An edge whose two distinct end vertices lie at the same point. `edge`
+    /// holds SOURCE vertex indices: welding has made both ends one vertex.
     ZeroLengthEdge { edge: [u32; 2], face: u32 },
     /// A face that uses the same vertex twice (a collapsed edge).
     DegenerateFace { face: u32, vertices: [u32; 3] },
