@@ -1,0 +1,313 @@
+#!/usr/bin/env node
+// Benchmark harness: prints a table and writes bench-results/bench.json.
+//
+//   npm run bench                     (setup + build + this script)
+//   node scripts/bench.mjs [--no-native] [--no-browser] [--quick]
+//
+// Each entry of BENCHES is { env, stage, run(ctx) } and returns rows
+// { input, faces?, ms, runs?, note? } (env/stage are filled in). Later pipeline
+// stages (cones, solve) add entries here; a bench that cannot run returns
+// { skipped: 'reason' } and appears as a note instead of failing the harness.
+//
+// Inputs: fandisk.obj (committed sample) and a ≥1 M-face OBJ made by 1-to-4
+// midpoint subdivision of fandisk, cached in the temp directory.
+import { spawnSync } from 'node:child_process';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+const args = new Set(process.argv.slice(2));
+const quick = args.has('--quick');
+const MIN_BIG_FACES = 1_000_000;
+const env = { ...process.env, PATH: [path.join(os.homedir(), '.cargo/bin'), process.env.PATH].join(path.delimiter) };
+
+// ---------------------------------------------------------------- inputs
+
+/** Reads an OBJ's vertices and triangles (polygons fan-triangulated). */
+function readObj(file) {
+  const pos = [];
+  const tri = [];
+  for (const line of fs.readFileSync(file, 'utf8').split('\n')) {
+    if (line.startsWith('v ')) {
+      const [, x, y, z] = line.trim().split(/\s+/);
+      pos.push(+x, +y, +z);
+    } else if (line.startsWith('f ')) {
+      const idx = line.trim().split(/\s+/).slice(1).map((t) => {
+        const i = parseInt(t, 10);
+        return i < 0 ? pos.length / 3 + i : i - 1;
+      });
+      for (let k = 1; k + 1 < idx.length; k++) tri.push(idx[0], idx[k], idx[k + 1]);
+    }
+  }
+  return { positions: Float64Array.from(pos), triangles: Uint32Array.from(tri) };
+}
+
+/** One level of 1-to-4 midpoint subdivision (shared edge midpoints). */
+function subdivide({ positions, triangles }) {
+  const nv = positions.length / 3;
+  const mids = new Map();
+  const pos = Array.from(positions);
+  const mid = (a, b) => {
+    const key = a < b ? a * nv + b : b * nv + a;
+    let m = mids.get(key);
+    if (m === undefined) {
+      m = pos.length / 3;
+      pos.push((pos[3 * a] + pos[3 * b]) / 2, (pos[3 * a + 1] + pos[3 * b + 1]) / 2, (pos[3 * a + 2] + pos[3 * b + 2]) / 2);
+      mids.set(key, m);
+    }
+    return m;
+  };
+  const out = new Uint32Array(triangles.length * 4);
+  let j = 0;
+  for (let t = 0; t < triangles.length; t += 3) {
+    const [a, b, c] = [triangles[t], triangles[t + 1], triangles[t + 2]];
+    const [ab, bc, ca] = [mid(a, b), mid(b, c), mid(c, a)];
+    out.set([a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca], j);
+    j += 12;
+  }
+  return { positions: Float64Array.from(pos), triangles: out };
+}
+
+function writeObj(mesh, file) {
+  const fd = fs.openSync(file, 'w');
+  const chunk = [];
+  const flush = () => { fs.writeSync(fd, chunk.join('')); chunk.length = 0; };
+  const p = mesh.positions;
+  for (let i = 0; i < p.length; i += 3) {
+    chunk.push(`v ${p[i].toFixed(6)} ${p[i + 1].toFixed(6)} ${p[i + 2].toFixed(6)}\n`);
+    if (chunk.length >= 65536) flush();
+  }
+  const t = mesh.triangles;
+  for (let i = 0; i < t.length; i += 3) {
+    chunk.push(`f ${t[i] + 1} ${t[i + 1] + 1} ${t[i + 2] + 1}\n`);
+    if (chunk.length >= 65536) flush();
+  }
+  flush();
+  fs.closeSync(fd);
+}
+
+/** The subdivided fandisk with at least MIN_BIG_FACES faces (cached in the temp dir). */
+function bigObj(source) {
+  let mesh = readObj(source);
+  let levels = 0;
+  let faces = mesh.triangles.length / 3;
+  while (faces < MIN_BIG_FACES) { faces *= 4; levels++; }
+  const dir = path.join(os.tmpdir(), 'conemap-bench');
+  const file = path.join(dir, `fandisk-sub${levels}.obj`);
+  if (fs.existsSync(file) && fs.statSync(file).mtimeMs >= fs.statSync(source).mtimeMs) return { file, faces };
+  fs.mkdirSync(dir, { recursive: true });
+  process.stdout.write(`bench: writing ${file} (${levels} subdivision levels, ${faces.toLocaleString('en-US')} faces)… `);
+  for (let i = 0; i < levels; i++) mesh = subdivide(mesh);
+  writeObj(mesh, `${file}.tmp`);
+  fs.renameSync(`${file}.tmp`, file);
+  console.log(`${(fs.statSync(file).size / 2 ** 20).toFixed(0)} MB`);
+  return { file, faces };
+}
+
+const median = (xs) => [...xs].sort((a, b) => a - b)[Math.floor(xs.length / 2)];
+
+// ---------------------------------------------------------------- benches
+
+/**
+ * Runs a cargo example that prints one JSON line of timings; each timing field
+ * becomes a row. `unit` is the unit of the printed numbers ('s' or 'ms');
+ * `isTime(key)` picks the timing fields (counts such as faces are not times).
+ */
+function cargoExample(example, exampleArgs, input, { unit = 'ms', isTime = (k) => /_ms$/.test(k) } = {}) {
+  const src = path.join(root, 'crate/examples', `${example}.rs`);
+  if (!fs.existsSync(src)) return { skipped: `crate/examples/${example}.rs does not exist yet` };
+  const r = spawnSync('cargo', ['run', '--quiet', '--release', '-p', 'conemap', '--example', example, '--', ...exampleArgs], {
+    cwd: root, env, encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 64 * 2 ** 20,
+  });
+  if (r.status !== 0) return { skipped: `cargo run --example ${example} failed: ${(r.stderr || '').trim().split('\n').slice(-3).join(' | ')}` };
+  const line = r.stdout.trim().split('\n').reverse().find((l) => l.trim().startsWith('{'));
+  if (!line) return { skipped: `${example} printed no JSON line` };
+  const json = JSON.parse(line);
+  const faces = json.faces ?? json.triangles;
+  const rows = Object.entries(json)
+    .filter(([k, v]) => typeof v === 'number' && isTime(k))
+    .map(([k, v]) => ({ input, faces, stage: k, ms: unit === 's' ? v * 1000 : v }));
+  if (rows.length === 0) return { skipped: `no timing fields in ${line.slice(0, 160)}` };
+  return rows;
+}
+
+/** crate/examples/bench_import.rs [MESH.obj] [MIN_FACES]: subdivides to ≥ MIN_FACES, prints seconds. */
+function nativeImport(ctx) {
+  const out = [];
+  for (const { file, faces } of ctx.inputs) {
+    const minFaces = faces >= MIN_BIG_FACES ? MIN_BIG_FACES : 0;
+    const label = faces >= MIN_BIG_FACES ? `${path.basename(ctx.inputs[0].file)} subdivided` : path.basename(file);
+    const rows = cargoExample('bench_import', [ctx.inputs[0].file, String(minFaces)], label, {
+      unit: 's',
+      isTime: (k) => !/faces|vertices|bytes|count/i.test(k),
+    });
+    if (rows.skipped) return rows;
+    out.push(...rows);
+  }
+  return out;
+}
+
+function wasmNodeImport(ctx) {
+  const pkg = path.join(root, 'build/pkg-node/conemap.js');
+  if (!fs.existsSync(pkg)) return { skipped: 'build/pkg-node missing (run npm run build)' };
+  const wasm = createRequire(import.meta.url)(pkg);
+  const rows = [];
+  for (const { file } of ctx.inputs) {
+    const bytes = new Uint8Array(fs.readFileSync(file));
+    const runs = bytes.length > 50 * 2 ** 20 ? 2 : 7;
+    const times = [];
+    let faces = 0;
+    for (let i = 0; i < runs; i++) {
+      const t0 = performance.now();
+      const out = wasm.import_mesh([{ name: path.basename(file), bytes }]);
+      times.push(performance.now() - t0);
+      faces = out.indices.length / 3;
+    }
+    rows.push({ input: path.basename(file), faces, ms: median(times), runs, note: `min ${Math.min(...times).toFixed(1)} ms` });
+  }
+  return rows;
+}
+
+async function browserLoad(ctx) {
+  const big = ctx.inputs.find((i) => i.faces >= MIN_BIG_FACES);
+  if (!big) return { skipped: 'no ≥1 M-face input (--quick)' };
+  const { findChromium, launchChromium } = await import('./lib/chromium.mjs');
+  if (!findChromium()) return { skipped: 'no Chromium (set CHROMIUM_PATH or apt-get install chromium)' };
+  const { startServer } = await import('./serve.mjs');
+  const server = await startServer({ root: path.join(root, 'dist'), port: 0 });
+  const browser = await launchChromium();
+  try {
+    const page = await browser.context.newPage();
+    await page.goto(server.url);
+    await page.waitForFunction(() => window.__conemap?.state === 'ready', null, { timeout: 120_000 });
+    // Two loads of the big file: first with the canvas hidden, so the frame gaps
+    // measure the page's own main-thread work (read, worker round trip, geometry
+    // upload); then visible, which adds software-GL (SwiftShader) rasterisation of
+    // every triangle: seconds in headless Chromium, milliseconds on a real GPU.
+    const input = path.basename(big.file);
+    const rows = [];
+    for (const hidden of [true, false]) {
+      const m = await measureLoad(page, big.file, hidden);
+      if (m.state !== 'ready') return { skipped: `page did not load the file: ${m.lastError}` };
+      const tag = hidden ? 'canvas hidden' : 'canvas visible';
+      if (hidden) {
+        rows.push(
+          { stage: 'read file', input, ms: m.timings.read, note: 'FileReader, main thread clock' },
+          { stage: 'worker round trip', input, faces: m.faces, ms: m.timings.worker, note: `wasm import ${m.importMs.toFixed(0)} ms + edges + transfer` },
+          { stage: 'build + draw call', input, ms: m.timings.draw },
+        );
+      }
+      rows.push(
+        { stage: `file input → ready (${tag})`, input, faces: m.faces, ms: m.wall, note: 'wall clock' },
+        { stage: `longest frame gap (${tag})`, input, ms: m.maxGap, note: hidden ? "the page's own main-thread work" : 'includes SwiftShader rasterisation' },
+        { stage: `longest long task (${tag})`, input, ms: m.maxLongTask, note: m.maxLongTask ? '' : 'none observed (> 50 ms)' },
+      );
+    }
+    return rows;
+  } finally {
+    await browser.close();
+    await server.close();
+  }
+}
+
+/** Loads `file` through the page's file input while watching animation frames and long tasks. */
+async function measureLoad(page, file, hideCanvas) {
+  await page.evaluate((hide) => {
+    document.querySelector('[data-testid=canvas]').style.visibility = hide ? 'hidden' : '';
+    const m = { maxGap: 0, maxLongTask: 0, running: true };
+    window.__bench = m;
+    let last = performance.now();
+    const tick = (t) => {
+      m.maxGap = Math.max(m.maxGap, t - last);
+      last = t;
+      if (m.running) requestAnimationFrame(tick);
+    };
+    requestAnimationFrame(tick);
+    try {
+      m.observer = new PerformanceObserver((list) => {
+        for (const e of list.getEntries()) m.maxLongTask = Math.max(m.maxLongTask, e.duration);
+      });
+      m.observer.observe({ type: 'longtask', buffered: false });
+    } catch { /* longtask entries not supported */ }
+  }, hideCanvas);
+  const loadsBefore = await page.evaluate(() => window.__conemap.loads);
+  const t0 = performance.now();
+  await page.getByTestId('file-input').setInputFiles(file);
+  await page.waitForFunction((n) => window.__conemap.loads > n && window.__conemap.state !== 'loading', loadsBefore, { timeout: 600_000, polling: 50 });
+  const wall = performance.now() - t0;
+  // Let the frame that shows the mesh (and any work it triggers) happen.
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(() => setTimeout(r, 200)))));
+  return page.evaluate((w) => {
+    const c = window.__conemap;
+    const m = window.__bench;
+    m.running = false;
+    m.observer?.disconnect();
+    return { wall: w, state: c.state, lastError: c.lastError, faces: c.stats?.faces, importMs: c.stats?.importMs ?? NaN, timings: c.timings, maxGap: m.maxGap, maxLongTask: m.maxLongTask };
+  }, wall);
+}
+
+const BENCHES = [
+  { env: 'native', stage: 'import', run: nativeImport, enabled: !args.has('--no-native') },
+  { env: 'native', stage: 'ldlt', run: () => cargoExample('bench_ldlt', [], 'bumpy grid'), enabled: !args.has('--no-native') && !quick },
+  { env: 'wasm-node', stage: 'import', run: wasmNodeImport, enabled: true },
+  { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
+];
+
+// ---------------------------------------------------------------- main
+
+const fandisk = path.join(root, 'web/public/samples/fandisk.obj');
+const inputs = [{ file: fandisk, faces: 12946 }];
+if (!quick) inputs.push(bigObj(fandisk));
+
+const rows = [];
+const notes = [];
+for (const b of BENCHES.filter((x) => x.enabled)) {
+  process.stdout.write(`bench: ${b.env} ${b.stage}… `);
+  const t0 = performance.now();
+  let result;
+  try {
+    result = await b.run({ inputs });
+  } catch (e) {
+    result = { skipped: `error: ${e.message.split('\n')[0]}` };
+  }
+  if (result.skipped) {
+    notes.push(`${b.env} ${b.stage}: ${result.skipped}`);
+    console.log(`skipped (${result.skipped})`);
+    continue;
+  }
+  console.log(`${((performance.now() - t0) / 1000).toFixed(1)} s`);
+  for (const r of result) rows.push({ ...r, env: b.env, stage: r.stage ? `${b.stage}: ${r.stage}` : b.stage });
+}
+
+const fmt = (v) => (typeof v === 'number' ? (Number.isNaN(v) ? '—' : v >= 100 ? v.toFixed(0) : v.toFixed(1)) : v ?? '');
+const cols = [
+  ['env', (r) => r.env],
+  ['stage', (r) => r.stage],
+  ['input', (r) => r.input],
+  ['faces', (r) => (r.faces ? r.faces.toLocaleString('en-US') : '')],
+  ['ms', (r) => fmt(r.ms)],
+  ['note', (r) => [r.runs ? `median of ${r.runs}` : '', r.note ?? ''].filter(Boolean).join('; ')],
+];
+const cells = rows.map((r) => cols.map(([, f]) => String(f(r))));
+const widths = cols.map(([h], i) => Math.max(h.length, ...cells.map((c) => c[i].length)));
+const line = (c) => c.map((s, i) => (i === 3 || i === 4 ? s.padStart(widths[i]) : s.padEnd(widths[i]))).join('  ');
+console.log();
+console.log(line(cols.map(([h]) => h)));
+console.log(line(widths.map((w) => '-'.repeat(w))));
+for (const c of cells) console.log(line(c));
+for (const n of notes) console.log(`note: ${n}`);
+
+const outDir = path.join(root, 'bench-results');
+fs.mkdirSync(outDir, { recursive: true });
+const report = {
+  date: new Date().toISOString(),
+  machine: { platform: `${os.platform()} ${os.arch()}`, cpus: os.cpus().length, cpu: os.cpus()[0]?.model, node: process.version },
+  inputs: inputs.map((i) => ({ file: path.relative(root, i.file).startsWith('..') ? i.file : path.relative(root, i.file), faces: i.faces })),
+  rows,
+  notes,
+};
+fs.writeFileSync(path.join(outDir, 'bench.json'), `${JSON.stringify(report, null, 2)}\n`);
+console.log(`\nbench: wrote ${path.relative(root, path.join(outDir, 'bench.json'))}`);
