@@ -6,7 +6,10 @@
 //! file bytes → [`io`] (a [`RawMesh`]) → [`mesh`] (a validated [`TriMesh`])
 //! → discrete operators → cone placement → cut and field → parametrization → export.
 
+pub mod clock;
+pub mod cones;
 pub mod error;
+pub mod features;
 pub mod io;
 pub mod linalg;
 pub mod mesh;

@@ -4,7 +4,9 @@
 //! arguments after its name, so later commands (`cones`, `solve`) slot into
 //! [`COMMANDS`] and [`run`].
 
-use conemap::mesh::{analyze, MeshReport};
+use conemap::cones::{self, ConeOptions, ConePlacement};
+use conemap::features::FeatureSet;
+use conemap::mesh::{analyze, MeshReport, TriMesh};
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -17,14 +19,28 @@ commands:
                        characteristic, genus) and every problem found.
                        --json prints one JSON object instead.
 
+  cones FILE [--alpha A] [--miq] [--sharp DEG] [--features FEATURES.json]
+             [--no-moves] [--json]
+                       place cones (Myles & Zorin 2013, sections 4-5).
+                       --alpha: alpha_smooth, 1e-4..1e3 (default 0.01; 100
+                       with --miq). --miq: MIQ emulation (no harmonic
+                       minimality). --sharp: edges with dihedral angle above
+                       DEG degrees are features. --features: a JSON file
+                       {\"edges\": [[[x,y,z],[x,y,z]], ...]} of feature edges
+                       by end positions. --no-moves: skip the cone-location
+                       optimization. --json prints one JSON object.
+
 options:
   -h, --help           print this help
 
-Exit status: 0 when the file was read (even if it has problems), 1 when it
-could not be read or parsed, 2 for bad usage.";
+Exit status: 0 on success (for info: when the file was read, even if it has
+problems), 1 when the input could not be read, parsed or used, 2 for bad usage.";
 
 /// Commands and the flags they accept.
-const COMMANDS: &[(&str, &[&str])] = &[("info", &["--json"])];
+const COMMANDS: &[(&str, &[&str])] = &[
+    ("info", &["--json"]),
+    ("cones", &["--json", "--miq", "--no-moves", "--alpha=", "--sharp=", "--features="]),
+];
 
 /// A failure: the one-line message and the exit status.
 struct Failure(String, u8);
@@ -60,6 +76,7 @@ fn run(args: &[String]) -> Result<(), Failure> {
             }
             match name {
                 "info" => info(&parsed),
+                "cones" => cones_command(&parsed),
                 _ => unreachable!("command listed in COMMANDS without a handler"),
             }
         }
@@ -70,19 +87,32 @@ fn usage(msg: &str) -> Failure {
     Failure(format!("{msg} (try `conemap --help`)"), 2)
 }
 
-/// Positional arguments and `--flag`s of one command.
+/// Positional arguments, `--flag`s and `--option value`s of one command
+/// (an allowed name ending in `=` takes a value).
 struct Args {
     positional: Vec<String>,
     flags: Vec<String>,
+    values: Vec<(String, String)>,
     help: bool,
 }
 
 impl Args {
     fn parse(args: &[String], allowed: &[&str]) -> Result<Args, Failure> {
-        let mut out = Args { positional: Vec::new(), flags: Vec::new(), help: false };
+        let mut out = Args { positional: Vec::new(), flags: Vec::new(), values: Vec::new(), help: false };
         let mut only_positional = false;
-        for a in args {
-            if only_positional || !a.starts_with('-') || a == "-" {
+        let mut it = args.iter();
+        while let Some(a) = it.next() {
+            let (name, inline) = match a.split_once('=') {
+                Some((n, v)) if a.starts_with("--") => (n, Some(v.to_string())),
+                _ => (a.as_str(), None),
+            };
+            if !only_positional && allowed.contains(&format!("{name}=").as_str()) {
+                let value = match inline {
+                    Some(v) => v,
+                    None => it.next().cloned().ok_or_else(|| usage(&format!("{name} needs a value")))?,
+                };
+                out.values.push((name.to_string(), value));
+            } else if only_positional || !a.starts_with('-') || a == "-" {
                 out.positional.push(a.clone());
             } else if a == "--" {
                 only_positional = true;
@@ -98,6 +128,22 @@ impl Args {
     }
     fn flag(&self, name: &str) -> bool {
         self.flags.iter().any(|f| f == name)
+    }
+    /// The value of `--name`, parsed as a number, if given.
+    fn number(&self, name: &str) -> Result<Option<f64>, Failure> {
+        match self.values.iter().rev().find(|(n, _)| n == name) {
+            None => Ok(None),
+            Some((_, v)) => v
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .map(Some)
+                .ok_or_else(|| usage(&format!("{name} expects a number, got \"{v}\""))),
+        }
+    }
+    /// The value of `--name`, if given.
+    fn value(&self, name: &str) -> Option<&str> {
+        self.values.iter().rev().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
     }
     /// The single positional FILE argument.
     fn file(&self) -> Result<&str, Failure> {
@@ -167,4 +213,97 @@ fn print_report(file: &str, r: &MeshReport) {
             println!("    … and {} more (use --json for all)", r.problems.len() - MAX_PROBLEMS);
         }
     }
+}
+
+/// Reads FILE and builds the validated mesh; problems become one message.
+fn load_mesh(file: &str) -> Result<TriMesh, Failure> {
+    let raw = conemap::io::import_path(Path::new(file)).map_err(|e| Failure(e.to_string(), 1))?;
+    TriMesh::from_raw(&raw).map_err(|problems| {
+        let first = problems.first().map(|p| p.to_string()).unwrap_or_default();
+        let more = if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
+        Failure(format!("{file}: cannot be parametrized: {first}{more}"), 1)
+    })
+}
+
+/// Feature edges from `--sharp` and `--features`.
+fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
+    let mut features = FeatureSet::none(mesh);
+    if let Some(deg) = args.number("--sharp")? {
+        features.union(&FeatureSet::sharp_edges(mesh, deg));
+    }
+    if let Some(path) = args.value("--features") {
+        let text = std::fs::read_to_string(path).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
+        #[derive(serde::Deserialize)]
+        struct FeatureFile {
+            edges: Vec<[[f64; 3]; 2]>,
+        }
+        let list: FeatureFile = serde_json::from_str(&text).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
+        let given = FeatureSet::from_positions(mesh, &list.edges).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
+        features.union(&given);
+    }
+    Ok(features)
+}
+
+fn cone_options(args: &Args) -> Result<ConeOptions, Failure> {
+    let miq = args.flag("--miq");
+    let default_alpha = if miq { cones::MIQ_ALPHA } else { cones::DEFAULT_ALPHA };
+    let alpha = args.number("--alpha")?.unwrap_or(default_alpha);
+    let (lo, hi) = cones::ALPHA_RANGE;
+    if !(lo..=hi).contains(&alpha) {
+        return Err(usage(&format!("--alpha {alpha} is outside {lo}..{hi}")));
+    }
+    Ok(ConeOptions { alpha_smooth: alpha, miq, optimize_locations: !args.flag("--no-moves"), ..ConeOptions::default() })
+}
+
+fn cones_command(args: &Args) -> Result<(), Failure> {
+    let file = args.file()?;
+    let mesh = load_mesh(file)?;
+    let features = load_features(args, &mesh)?;
+    let options = cone_options(args)?;
+    let result = cones::place_cones(&mesh, &features, &options, &mut |_| {}).map_err(|e| Failure(e.to_string(), 1))?;
+    if args.flag("--json") {
+        println!("{}", cones_json(&mesh, &features, &options, &result));
+    } else {
+        print_cones(file, &mesh, &features, &options, &result);
+    }
+    Ok(())
+}
+
+fn cones_json(mesh: &TriMesh, features: &FeatureSet, options: &ConeOptions, r: &ConePlacement) -> serde_json::Value {
+    serde_json::json!({
+        "vertices": mesh.n_vertices(),
+        "faces": mesh.n_faces(),
+        "feature_edges": features.len(),
+        "alpha_smooth": options.alpha_smooth,
+        "miq": options.miq,
+        "euler_characteristic": mesh.euler_characteristic(),
+        "cones": r.cones,
+        "boundary_corners": r.boundary_corners,
+        "components": r.components,
+        "rounds": r.rounds,
+        "energy": r.energy,
+        "phi_rms": r.phi_rms,
+        "timings": r.timings,
+    })
+}
+
+fn print_cones(file: &str, mesh: &TriMesh, features: &FeatureSet, options: &ConeOptions, r: &ConePlacement) {
+    println!("{file}: {} vertices, {} faces, {} feature edges", mesh.n_vertices(), mesh.n_faces(), features.len());
+    println!(
+        "  alpha_smooth {}{}: {} cones ({} positive, {} negative), {} boundary corners",
+        options.alpha_smooth,
+        if options.miq { " (MIQ emulation)" } else { "" },
+        r.cones.len(),
+        r.cones.iter().filter(|c| c.k > 0).count(),
+        r.cones.iter().filter(|c| c.k < 0).count(),
+        r.boundary_corners.len()
+    );
+    let k_sum: i32 = r.cones.iter().chain(&r.boundary_corners).map(|c| c.k).sum();
+    println!("  sum of k: {k_sum} (4 chi = {})", 4 * mesh.euler_characteristic());
+    println!("  energy {:.6}, phi rms {:.6}, {} rounding rounds", r.energy, r.phi_rms, r.rounds);
+    let t = &r.timings;
+    println!(
+        "  time: cut {:.3} s, topology {:.3} s, rounding {:.3} s, cone moves {:.3} s, total {:.3} s",
+        t.cut, t.topology, t.rounding, t.cone_moves, t.total
+    );
 }

@@ -1,0 +1,250 @@
+//! Per-face tangent frames and the quantities measured along dual paths:
+//! frame transport across edges (`kappa`), boundary port angles, the
+//! conformal part of the connection on midline segments (eq. 11) and the
+//! total geodesic curvature of a dual path (eq. 14).
+//!
+//! A dual path is a list of [`Visit`]s: in face `h_in / 3` it runs along the
+//! midline segment from the midpoint of halfedge `h_in` to that of `h_out`.
+//! Between two visits it either crosses an interior edge (`twin(h_out) ==
+//! next.h_in`) or passes through the outer node through two boundary edges.
+
+use crate::mesh::TriMesh;
+use std::f64::consts::PI;
+
+/// One face of a dual path: enters through the edge of face halfedge `h_in`,
+/// leaves through the edge of face halfedge `h_out` (same face).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Visit {
+    pub h_in: u32,
+    pub h_out: u32,
+}
+
+/// Orthonormal tangent frame of every face: x along the face's first edge,
+/// y = n × x.
+#[derive(Clone, Debug)]
+pub struct Frames {
+    x: Vec<[f64; 3]>,
+    y: Vec<[f64; 3]>,
+    area: Vec<f64>,
+}
+
+impl Frames {
+    /// Frames of all faces of `mesh` (faces have positive area: `TriMesh` is validated).
+    pub fn new(mesh: &TriMesh) -> Frames {
+        let nf = mesh.n_faces();
+        let (mut x, mut y, mut area) = (Vec::with_capacity(nf), Vec::with_capacity(nf), Vec::with_capacity(nf));
+        for f in 0..nf as u32 {
+            let [h0, h1, _] = mesh.face_halfedges(f);
+            let e0 = mesh.halfedge_vector(h0);
+            let e1 = mesh.halfedge_vector(h1);
+            let n = cross(e0, e1);
+            let nn = norm(n);
+            let xa = scale(e0, 1.0 / norm(e0));
+            let na = scale(n, 1.0 / nn);
+            x.push(xa);
+            y.push(cross(na, xa));
+            area.push(0.5 * nn);
+        }
+        Frames { x, y, area }
+    }
+
+    /// Angle of tangent vector `d` in the frame of face `f`.
+    #[inline]
+    pub fn angle(&self, f: u32, d: [f64; 3]) -> f64 {
+        let (x, y) = (self.x[f as usize], self.y[f as usize]);
+        dot(d, y).atan2(dot(d, x))
+    }
+
+    /// Angle of face halfedge `h`'s direction in its face's frame.
+    #[inline]
+    pub fn halfedge_angle(&self, mesh: &TriMesh, h: u32) -> f64 {
+        self.angle(h / 3, mesh.halfedge_vector(h))
+    }
+
+    /// Frame rotation crossing the edge of face halfedge `h` from its face to
+    /// the twin's face: `angle_g(d) - angle_f(d)` for the edge direction `d`,
+    /// wrapped to (-pi, pi]. Requires an interior edge.
+    #[inline]
+    pub fn kappa(&self, mesh: &TriMesh, h: u32) -> f64 {
+        let [h0, h1] = mesh.edge_halfedges(mesh.edge(h));
+        // The twin runs the other way: its angle is the edge's plus pi.
+        // Computed once per edge so kappa(twin) = -kappa exactly, even at ±pi.
+        let k = wrap(self.halfedge_angle(mesh, h1) - PI - self.halfedge_angle(mesh, h0));
+        if h == h0 {
+            k
+        } else {
+            -k
+        }
+    }
+
+    /// Area of face `f`.
+    #[inline]
+    pub fn area(&self, f: u32) -> f64 {
+        self.area[f as usize]
+    }
+
+    /// Transport term between two consecutive visits: `kappa` across an
+    /// interior edge, or the two port terms through the outer node
+    /// (`-angle` of the edge left, `+angle` of the edge entered).
+    pub fn transition(&self, mesh: &TriMesh, from: Visit, to: Visit) -> f64 {
+        if mesh.twin(from.h_out) == to.h_in {
+            self.kappa(mesh, from.h_out)
+        } else {
+            debug_assert!(mesh.is_boundary_halfedge(mesh.twin(from.h_out)));
+            debug_assert!(mesh.is_boundary_halfedge(mesh.twin(to.h_in)));
+            self.halfedge_angle(mesh, to.h_in) - self.halfedge_angle(mesh, from.h_out)
+        }
+    }
+
+    /// Geometric part of the holonomy of a closed dual cycle: the sum of the
+    /// transitions between its consecutive visits (cyclically).
+    pub fn cycle_transport(&self, mesh: &TriMesh, cycle: &[Visit]) -> f64 {
+        (0..cycle.len()).map(|i| self.transition(mesh, cycle[i], cycle[(i + 1) % cycle.len()])).sum()
+    }
+
+    /// Coefficients of the conformal connection `-*dphi` on the midline
+    /// segment of `visit` (eq. 11): the segment value is
+    /// `sum_k c[k] * phi[corner k of the face]`. With this sign the values
+    /// around a vertex sum to `(L phi)_v` for the positive semi-definite
+    /// cotangent Laplacian `L`.
+    pub fn segment_phi_coefficients(&self, mesh: &TriMesh, visit: Visit) -> [f64; 3] {
+        let f = visit.h_in / 3;
+        let t = sub(midpoint(mesh, visit.h_out), midpoint(mesh, visit.h_in));
+        let two_area = 2.0 * self.area(f);
+        // Edge opposite corner k runs from corner k+1 to corner k+2: halfedge 3f + (k+1)%3.
+        [0, 1, 2].map(|k| dot(mesh.halfedge_vector(3 * f + (k + 1) % 3), t) / two_area)
+    }
+
+    /// Total geodesic curvature of an open dual path (eq. 14): the sum of the
+    /// turning angles between consecutive midline segments, the second
+    /// triangle unfolded about the shared edge.
+    pub fn path_geodesic_curvature(&self, mesh: &TriMesh, path: &[Visit]) -> f64 {
+        path.windows(2)
+            .map(|w| {
+                let (a, b) = (w[0], w[1]);
+                debug_assert_eq!(mesh.twin(a.h_out), b.h_in);
+                let fa = a.h_in / 3;
+                let fb = b.h_in / 3;
+                let da = self.angle(fa, sub(midpoint(mesh, a.h_out), midpoint(mesh, a.h_in)));
+                let db = self.angle(fb, sub(midpoint(mesh, b.h_out), midpoint(mesh, b.h_in)));
+                wrap(db - (da + self.kappa(mesh, a.h_out)))
+            })
+            .sum()
+    }
+}
+
+/// Wraps an angle to (-pi, pi].
+#[inline]
+pub fn wrap(a: f64) -> f64 {
+    let mut r = a % (2.0 * PI);
+    if r <= -PI {
+        r += 2.0 * PI;
+    } else if r > PI {
+        r -= 2.0 * PI;
+    }
+    r
+}
+
+/// The visits of the dual cycle around vertex `v`, counter-clockwise: for an
+/// interior vertex a closed loop, for a boundary vertex the fan from one
+/// boundary edge to the other (closed through the outer node).
+pub fn vertex_cycle(mesh: &TriMesh, v: u32) -> Vec<Visit> {
+    mesh.outgoing(v)
+        .filter(|&h| !mesh.is_boundary_halfedge(h))
+        .map(|h| Visit { h_in: h, h_out: mesh.prev(h) })
+        .collect()
+}
+
+fn midpoint(mesh: &TriMesh, h: u32) -> [f64; 3] {
+    let a = mesh.position(mesh.tail(h));
+    let b = mesh.position(mesh.head(h));
+    [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])]
+}
+
+#[inline]
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+#[inline]
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+#[inline]
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+#[inline]
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+#[inline]
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cones::test_meshes::{grid, octahedron};
+    use crate::operators;
+
+    /// The holonomy constant of every vertex cycle is the angle defect modulo 2 pi.
+    fn check_vertex_transport(mesh: &TriMesh) {
+        let frames = Frames::new(mesh);
+        let is_b: Vec<bool> = (0..mesh.n_vertices() as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
+        let defects = operators::angle_defects(mesh.positions(), mesh.faces(), &is_b);
+        for v in 0..mesh.n_vertices() as u32 {
+            let g = frames.cycle_transport(mesh, &vertex_cycle(mesh, v));
+            let j = (defects[v as usize] - g) / (2.0 * PI);
+            assert!((j - j.round()).abs() < 1e-9, "vertex {v}: transport {g}, defect {}", defects[v as usize]);
+        }
+    }
+
+    #[test]
+    fn vertex_transport_matches_angle_defects() {
+        check_vertex_transport(&octahedron());
+        check_vertex_transport(&grid(5, 4, |x, y| [x, y, 0.3 * (x * y).sin()]));
+    }
+
+    #[test]
+    fn segment_values_around_a_vertex_sum_to_the_laplacian() {
+        let mesh = grid(6, 5, |x, y| [x, y, 0.2 * (2.0 * x).cos() * y]);
+        let frames = Frames::new(&mesh);
+        let phi: Vec<f64> = (0..mesh.n_vertices()).map(|i| ((i * 7919) % 13) as f64 * 0.1).collect();
+        let l = operators::cotan_laplacian(mesh.positions(), mesh.faces());
+        for v in 0..mesh.n_vertices() as u32 {
+            let mut sum = 0.0;
+            for visit in vertex_cycle(&mesh, v) {
+                let c = frames.segment_phi_coefficients(&mesh, visit);
+                let tri = mesh.faces()[(visit.h_in / 3) as usize];
+                sum += (0..3).map(|k| c[k] * phi[tri[k] as usize]).sum::<f64>();
+            }
+            let row = l.outer_view(v as usize).unwrap();
+            let lphi: f64 = row.iter().map(|(j, &w)| w * phi[j]).sum();
+            assert!((sum - lphi).abs() < 1e-12, "vertex {v}: {sum} vs {lphi}");
+        }
+    }
+
+    #[test]
+    fn segments_of_one_face_close() {
+        let mesh = octahedron();
+        let frames = Frames::new(&mesh);
+        let [a, b, c] = mesh.face_halfedges(0);
+        let total: [f64; 3] = [Visit { h_in: a, h_out: b }, Visit { h_in: b, h_out: c }, Visit { h_in: c, h_out: a }]
+            .iter()
+            .map(|&v| frames.segment_phi_coefficients(&mesh, v))
+            .fold([0.0; 3], |s, x| [s[0] + x[0], s[1] + x[1], s[2] + x[2]]);
+        assert!(total.iter().all(|t| t.abs() < 1e-14));
+    }
+
+    #[test]
+    fn geodesic_curvature_of_the_midline_loop_is_the_angle_sum() {
+        // Around a cone of angle sum S the unfolded midline polygon turns by S (eq. 14).
+        let mesh = octahedron();
+        let frames = Frames::new(&mesh);
+        let mut cycle = vertex_cycle(&mesh, 0);
+        cycle.push(cycle[0]);
+        let turning = frames.path_geodesic_curvature(&mesh, &cycle);
+        assert!((turning - 4.0 * PI / 3.0).abs() < 1e-12, "turning {turning}"); // four 60° corners
+    }
+}

@@ -1,0 +1,527 @@
+//! The constrained problem of section 5.3 on one connected component, and
+//! Algorithm 1 (greedy rounding of the path integers `p`).
+//!
+//! Unknowns `x = [phi (V) | h~ (n_h) | p (|G|)]` with `h = h~ / sqrt(W)`.
+//! Constraint rows (eq. 16, written per cycle of the augmented dual graph):
+//! * vertex `v` (all but one, their sum is zero):
+//!   `(L phi)_v - (pi/2) sum_e sigma_ve p_e = -transport(gamma_v)`;
+//! * leftover `l` (`G_path`): `B_phi phi + B_h h - (pi/2) p_l = -transport(C_l)`;
+//! * fix `e`: `t_e p_e = t_e c_e` (`t_e = 1` once `p_e` is rounded);
+//! * pin: boundary vertex rows `sum_e sigma_ve p_e = k_v - 4 j_v` that
+//!   peeling could not turn into fixes.
+//! Objective (eq. 18 with the harmonic minimality (17) as a lexicographic
+//! weight, see docs/cone-placement.md): `phiᵀ(alpha L + M/A)phi + W hᵀ M_1 h`;
+//! MIQ emulation: `alpha (phiᵀ L phi + hᵀ M_1 h) + phiᵀ M phi / A`.
+//! Only values change between rounds, so the symbolic analysis is done once.
+
+use super::dual_tree::DualTree;
+use super::frames::{vertex_cycle, Frames, Visit};
+use super::harmonic::HarmonicBasis;
+use crate::linalg::{Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
+use crate::mesh::{TriMesh, NONE};
+use std::f64::consts::FRAC_PI_2;
+use std::f64::consts::PI;
+
+/// Weight of the harmonic norm in the lexicographic objective.
+const HARMONIC_WEIGHT: f64 = 1e4;
+/// Proximal weight on the free integers (see the assembly).
+const P_PROXIMAL: f64 = 1e-8;
+/// Total rounding allowed per batch (Algorithm 1: below 0.5).
+const ROUNDING_BATCH: f64 = 0.5;
+
+/// One vertex's cycle expressed in the path basis.
+#[derive(Clone, Debug)]
+struct VertexCycle {
+    /// `G` indices and signs `sigma_ve`.
+    g: Vec<(u32, i32)>,
+    /// Geometric holonomy (transport) of the cycle.
+    transport: f64,
+    /// `j_v`: `(K_v - transport) / 2 pi`, an integer.
+    j: i64,
+}
+
+/// Settings of one solve.
+#[derive(Clone, Copy, Debug)]
+pub struct Weights {
+    pub alpha_smooth: f64,
+    pub miq: bool,
+}
+
+/// The KKT system of one component, its factorization and the rounding state.
+pub struct ComponentSystem<'a> {
+    mesh: &'a TriMesh,
+    pub tree: DualTree,
+    pub basis: HarmonicBasis,
+    /// Mesh vertex → local index (`NONE` outside the component).
+    local: Vec<u32>,
+    cycles: Vec<VertexCycle>,
+    /// Angle defects (2 pi or pi minus the angle sum) per local vertex.
+    defect: Vec<f64>,
+    /// Vertex areas per local vertex, and the component's area.
+    area: Vec<f64>,
+    total_area: f64,
+    /// Fixed value of each `p` (`None` while free).
+    pub fixed: Vec<Option<i64>>,
+    n: usize,
+    row_fix: usize,
+    constraint_rhs: Vec<f64>,
+    kkt: Kkt,
+    solver: LdltSolver,
+    /// Slot of each fix row's coefficient `t_e` in the KKT values.
+    fix_slots: Vec<usize>,
+    h_scale: f64,
+    /// Last solution.
+    pub x: Vec<f64>,
+    pub residual: f64,
+    pub rounds: usize,
+}
+
+/// What went wrong while placing cones.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConeError {
+    Solve(SolveError),
+    /// The boundary turning integers admit no integer path values (an internal inconsistency).
+    InconsistentBoundary { vertex: u32 },
+}
+
+impl From<SolveError> for ConeError {
+    fn from(e: SolveError) -> Self {
+        ConeError::Solve(e)
+    }
+}
+
+impl std::fmt::Display for ConeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ConeError::Solve(e) => write!(f, "cone placement: linear solve failed: {e}"),
+            ConeError::InconsistentBoundary { vertex } => {
+                write!(f, "cone placement: boundary turning at vertex v{vertex} is inconsistent")
+            }
+        }
+    }
+}
+
+impl std::error::Error for ConeError {}
+
+impl<'a> ComponentSystem<'a> {
+    /// Builds and factorizes the system for the component containing face
+    /// `seed`; boundary vertices get the turning integers of `boundary_k`
+    /// (indexed by mesh vertex).
+    pub fn new(
+        mesh: &'a TriMesh,
+        frames: &Frames,
+        seed: u32,
+        boundary_k: &[i32],
+        weights: Weights,
+    ) -> Result<Self, ConeError> {
+        let tree = DualTree::new(mesh, seed);
+        let basis = HarmonicBasis::new(mesh, &tree)?;
+        let nv = tree.vertices.len();
+        let nh = basis.len();
+        let ng = tree.g_edges.len();
+        let mut local = vec![NONE; mesh.n_vertices()];
+        for (i, &v) in tree.vertices.iter().enumerate() {
+            local[v as usize] = i as u32;
+        }
+
+        // Per-vertex geometry on the component.
+        let mut angle_sum = vec![0.0; nv];
+        let mut area = vec![0.0; nv];
+        let angles = crate::operators::corner_angles(mesh.positions(), mesh.faces());
+        for &f in &tree.faces {
+            let tri = mesh.faces()[f as usize];
+            let a = frames.area(f);
+            for k in 0..3 {
+                let i = local[tri[k] as usize] as usize;
+                angle_sum[i] += angles[f as usize][k];
+                area[i] += a / 3.0;
+            }
+        }
+        let total_area: f64 = area.iter().sum();
+        let defect: Vec<f64> = tree
+            .vertices
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| if mesh.is_boundary_vertex(v) { PI } else { 2.0 * PI } - angle_sum[i])
+            .collect();
+
+        // Vertex cycles in the path basis.
+        let cycles: Vec<VertexCycle> = tree
+            .vertices
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                let cycle = vertex_cycle(mesh, v);
+                let transport = frames.cycle_transport(mesh, &cycle);
+                let j = ((defect[i] - transport) / (2.0 * PI)).round() as i64;
+                VertexCycle { g: cycle_signs(mesh, &tree, &cycle), transport, j }
+            })
+            .collect();
+
+        // Boundary turning: peel what determines single p's, pin the rest.
+        let mut fixed: Vec<Option<i64>> = vec![None; ng];
+        let mut pending: Vec<usize> = (0..nv).filter(|&i| mesh.is_boundary_vertex(tree.vertices[i])).collect();
+        let target = |i: usize| boundary_k[tree.vertices[i] as usize] as i64 - 4 * cycles[i].j;
+        loop {
+            let mut progress = false;
+            let mut still = Vec::new();
+            for &i in &pending {
+                let unknown: Vec<&(u32, i32)> = cycles[i].g.iter().filter(|(g, _)| fixed[*g as usize].is_none()).collect();
+                let known: i64 = cycles[i]
+                    .g
+                    .iter()
+                    .filter_map(|&(g, s)| fixed[g as usize].map(|p| s as i64 * p))
+                    .sum();
+                match unknown.len() {
+                    0 => {
+                        if known != target(i) {
+                            return Err(ConeError::InconsistentBoundary { vertex: tree.vertices[i] });
+                        }
+                        progress = true;
+                    }
+                    1 => {
+                        let (g, s) = *unknown[0];
+                        fixed[g as usize] = Some((target(i) - known) * s as i64);
+                        progress = true;
+                    }
+                    _ => still.push(i),
+                }
+            }
+            pending = still;
+            if !progress || pending.is_empty() {
+                break;
+            }
+        }
+
+        // Assemble.
+        let n = nv + nh + ng;
+        let h_scale = if weights.miq { 1.0 } else { HARMONIC_WEIGHT.sqrt() };
+        let (p0, h0) = (nv + nh, nv);
+        let mut a: Vec<Triplet> = Vec::new();
+        let l = crate::operators::cotan_laplacian_triplets(mesh.positions(), mesh.faces());
+        let alpha = weights.alpha_smooth;
+        for &(r, c, w) in &l {
+            let (lr, lc) = (local[r] as usize, local[c] as usize);
+            if (lr as u32) != NONE && lr <= lc {
+                a.push((lr, lc, alpha * w));
+            }
+        }
+        for i in 0..nv {
+            a.push((i, i, area[i] / total_area));
+        }
+        let h_weight = if weights.miq { alpha } else { 1.0 };
+        for i in 0..nh {
+            for j in i..nh {
+                a.push((h0 + i, h0 + j, h_weight * basis.gram[i][j]));
+            }
+        }
+        // A tiny proximal term keeps the primal block definite (the matrix is
+        // then quasi-definite and LDLᵀ without pivoting is stable); it is a
+        // constant once every p is fixed, so final solutions are unaffected.
+        for g in 0..ng {
+            a.push((p0 + g, p0 + g, P_PROXIMAL));
+        }
+
+        let mut c: Vec<Triplet> = Vec::new();
+        let mut rhs: Vec<f64> = Vec::new();
+        let mut row = 0usize;
+        // Vertex rows (skip the last vertex: the rows sum to zero).
+        for &(r, col, w) in &l {
+            let (lr, lc) = (local[r], local[col]);
+            if lr != NONE && (lr as usize) + 1 < nv {
+                c.push((lr as usize, lc as usize, w));
+            }
+        }
+        for i in 0..nv.saturating_sub(1) {
+            for &(g, s) in &cycles[i].g {
+                c.push((i, p0 + g as usize, -FRAC_PI_2 * s as f64));
+            }
+            rhs.push(-cycles[i].transport);
+        }
+        row += nv.saturating_sub(1);
+        // Path rows.
+        for &e in &tree.leftovers {
+            let cycle = tree.fundamental_cycle(mesh, e);
+            for visit in &cycle {
+                let coef = frames.segment_phi_coefficients(mesh, *visit);
+                let tri = mesh.faces()[(visit.h_in / 3) as usize];
+                for k in 0..3 {
+                    c.push((row, local[tri[k] as usize] as usize, coef[k]));
+                }
+            }
+            for j in 0..nh {
+                c.push((row, h0 + j, basis.path_integral(j, &cycle) / h_scale));
+            }
+            c.push((row, p0 + tree.g_index[e as usize] as usize, -FRAC_PI_2));
+            rhs.push(-frames.cycle_transport(mesh, &cycle));
+            row += 1;
+        }
+        // Fix rows.
+        let row_fix = row;
+        for g in 0..ng {
+            c.push((row, p0 + g, if fixed[g].is_some() { 1.0 } else { 0.0 }));
+            rhs.push(fixed[g].unwrap_or(0) as f64);
+            row += 1;
+        }
+        // Pin rows.
+        for &i in &pending {
+            for &(g, s) in &cycles[i].g {
+                c.push((row, p0 + g as usize, s as f64));
+            }
+            rhs.push(target(i) as f64);
+            row += 1;
+        }
+        let m = row;
+        let kkt = Kkt::assemble(&a, n, &c, m)?;
+        let fix_slots = (0..ng)
+            .map(|g| kkt.pattern.slot(p0 + g, n + row_fix + g).expect("fix entry is in the pattern"))
+            .collect();
+        let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs)?;
+        solver.set_options(SolverOptions { max_refinement_steps: 50, ..SolverOptions::default() });
+        solver.factorize(&kkt.values)?;
+        Ok(ComponentSystem {
+            mesh,
+            tree,
+            basis,
+            local,
+            cycles,
+            defect,
+            area,
+            total_area,
+            fixed,
+            n,
+            row_fix,
+            constraint_rhs: rhs,
+            kkt,
+            solver,
+            fix_slots,
+            h_scale,
+            x: Vec::new(),
+            residual: f64::NAN,
+            rounds: 0,
+        })
+    }
+
+    fn p0(&self) -> usize {
+        self.tree.vertices.len() + self.basis.len()
+    }
+
+    /// Refactors after fixes changed and solves.
+    fn refactor_and_solve(&mut self) -> Result<(), ConeError> {
+        for (g, fx) in self.fixed.iter().enumerate() {
+            self.kkt.values[self.fix_slots[g]] = if fx.is_some() { 1.0 } else { 0.0 };
+            self.constraint_rhs[self.row_fix + g] = fx.unwrap_or(0) as f64;
+        }
+        self.solver.factorize(&self.kkt.values)?;
+        self.solve()
+    }
+
+    /// Solves with the current factorization and right-hand side.
+    pub(crate) fn solve(&mut self) -> Result<(), ConeError> {
+        let mut b = vec![0.0; self.n];
+        b.extend_from_slice(&self.constraint_rhs);
+        let (x, info) = self.solver.solve_with_info(&b)?;
+        self.x = x;
+        self.residual = info.relative_residual;
+        Ok(())
+    }
+
+    /// Algorithm 1: solve, fix the batch of free `p` nearest to integers
+    /// (total rounding below 0.5, at least one), repeat until all are fixed.
+    /// `progress(round, free_left)` is called after every solve.
+    pub fn round_all(&mut self, progress: &mut dyn FnMut(usize, usize)) -> Result<(), ConeError> {
+        self.refactor_and_solve()?;
+        loop {
+            let p0 = self.p0();
+            let mut free: Vec<(f64, usize)> = self
+                .fixed
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| f.is_none())
+                .map(|(g, _)| {
+                    let v = self.x[p0 + g];
+                    ((v - v.round()).abs(), g)
+                })
+                .collect();
+            progress(self.rounds, free.len());
+            if free.is_empty() {
+                return Ok(());
+            }
+            free.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut total = 0.0;
+            for (i, &(d, g)) in free.iter().enumerate() {
+                if i > 0 && total + d >= ROUNDING_BATCH {
+                    break;
+                }
+                total += d;
+                self.fixed[g] = Some(self.x[p0 + g].round() as i64);
+            }
+            self.rounds += 1;
+            self.refactor_and_solve()?;
+        }
+    }
+
+    /// The cone index of every local vertex: `k_v = 4 j_v + sum sigma p`
+    /// (all `p` must be fixed).
+    pub fn vertex_k(&self) -> Vec<i64> {
+        self.cycles
+            .iter()
+            .map(|c| 4 * c.j + c.g.iter().map(|&(g, s)| s as i64 * self.fixed[g as usize].unwrap_or(0)).sum::<i64>())
+            .collect()
+    }
+
+    /// `phi` per local vertex from the last solve.
+    pub fn phi(&self) -> &[f64] {
+        &self.x[..self.tree.vertices.len()]
+    }
+
+    /// Harmonic coefficients `h` from the last solve.
+    pub fn h(&self) -> Vec<f64> {
+        let nv = self.tree.vertices.len();
+        self.x[nv..nv + self.basis.len()].iter().map(|v| v / self.h_scale).collect()
+    }
+
+    /// Local index of mesh vertex `v`.
+    pub fn local(&self, v: u32) -> u32 {
+        self.local[v as usize]
+    }
+
+    /// `phiᵀ M phi / A`: the area-weighted mean of phi² (the distortion proxy).
+    pub fn phi_norm2(&self) -> f64 {
+        self.phi().iter().zip(&self.area).map(|(p, a)| p * p * a).sum::<f64>() / self.total_area
+    }
+
+    /// `phiᵀ (alpha L + M/A) phi` with `alpha` as given.
+    pub fn energy(&self, alpha: f64) -> f64 {
+        let phi = self.phi();
+        let mut e = self.phi_norm2();
+        for &f in &self.tree.faces {
+            let tri = self.mesh.faces()[f as usize];
+            let p = |k: usize| phi[self.local[tri[k] as usize] as usize];
+            let cot = face_cotangents(self.mesh, f);
+            for k in 0..3 {
+                // Edge opposite corner k, weight cot(angle k) / 2.
+                let (a, b) = (p((k + 1) % 3), p((k + 2) % 3));
+                e += alpha * 0.5 * cot[k] * (a - b) * (a - b);
+            }
+        }
+        e
+    }
+
+    /// Angle defects per local vertex.
+    pub fn defects(&self) -> &[f64] {
+        &self.defect
+    }
+
+    /// Moves cone index `amount` from local vertex `from` to `to` by changing
+    /// the fixed `p` along the `T_p` path (leftovers are never on it);
+    /// only the right-hand side changes.
+    pub(crate) fn transfer(&mut self, from: usize, to: usize, amount: i64) {
+        let (a, b) = (self.tree.vertices[from], self.tree.vertices[to]);
+        let path = self.tree.primal_path(self.mesh, a, b);
+        let mut x = a;
+        for (e, _) in path {
+            let [u, w] = self.mesh.edge_vertices(e);
+            let next = if u == x { w } else { u };
+            let g = self.tree.g_index[e as usize];
+            let s = self.cycles[self.local[x as usize] as usize]
+                .g
+                .iter()
+                .find(|(gg, _)| *gg == g)
+                .map(|&(_, s)| s as i64)
+                .expect("T_p edges are G edges of both end vertices");
+            let p = self.fixed[g as usize].as_mut().expect("all p fixed before cone moves");
+            *p -= amount * s;
+            self.constraint_rhs[self.row_fix + g as usize] = *p as f64;
+            x = next;
+        }
+    }
+
+    /// Cone-location optimization (section 5.3): moves each interior cone to
+    /// the neighbouring interior vertex that lowers `phiᵀ M phi / A` most,
+    /// until no move helps or `max_passes` passes. Returns the moves made.
+    pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
+        let mut moves = 0;
+        let mut current = self.phi_norm2();
+        for pass in 0..max_passes {
+            progress(pass);
+            let mut improved = false;
+            let k = self.vertex_k();
+            let cones: Vec<usize> = (0..k.len())
+                .filter(|&i| k[i] != 0 && !self.mesh.is_boundary_vertex(self.tree.vertices[i]))
+                .collect();
+            for i in cones {
+                let ki = self.vertex_k()[i];
+                if ki == 0 {
+                    continue;
+                }
+                let v = self.tree.vertices[i];
+                let mut best: Option<(f64, usize)> = None;
+                let neighbours: Vec<usize> = self
+                    .mesh
+                    .one_ring(v)
+                    .filter(|&w| !self.mesh.is_boundary_vertex(w))
+                    .map(|w| self.local[w as usize] as usize)
+                    .collect();
+                for j in neighbours {
+                    self.transfer(i, j, ki);
+                    self.solve()?;
+                    let e = self.phi_norm2();
+                    if e < current * (1.0 - 1e-9) && best.map_or(true, |(be, _)| e < be) {
+                        best = Some((e, j));
+                    }
+                    self.transfer(j, i, ki);
+                }
+                if let Some((e, j)) = best {
+                    self.transfer(i, j, ki);
+                    current = e;
+                    moves += 1;
+                    improved = true;
+                }
+            }
+            self.solve()?;
+            if !improved {
+                break;
+            }
+        }
+        Ok(moves)
+    }
+}
+
+/// The `G` edges a cycle crosses, with the sign `+1` when the cycle crosses
+/// in the orientation of the edge's fundamental cycle.
+fn cycle_signs(mesh: &TriMesh, tree: &DualTree, cycle: &[Visit]) -> Vec<(u32, i32)> {
+    let mut out = Vec::new();
+    for (i, visit) in cycle.iter().enumerate() {
+        let next = cycle[(i + 1) % cycle.len()];
+        let e = mesh.edge(visit.h_out);
+        if mesh.twin(visit.h_out) == next.h_in {
+            let g = tree.g_index[e as usize];
+            if g != NONE {
+                let s = if mesh.edge_halfedges(e)[0] == visit.h_out { 1 } else { -1 };
+                out.push((g, s));
+            }
+        } else {
+            // Through the outer node: leave by a port, enter by another.
+            let g_out = tree.g_index[e as usize];
+            if g_out != NONE {
+                out.push((g_out, -1));
+            }
+            let g_in = tree.g_index[mesh.edge(next.h_in) as usize];
+            if g_in != NONE {
+                out.push((g_in, 1));
+            }
+        }
+    }
+    out
+}
+
+fn face_cotangents(mesh: &TriMesh, f: u32) -> [f64; 3] {
+    let tri = mesh.faces()[f as usize];
+    let p = tri.map(|v| mesh.position(v));
+    [0, 1, 2].map(|k| {
+        let u = super::frames::sub(p[(k + 1) % 3], p[k]);
+        let w = super::frames::sub(p[(k + 2) % 3], p[k]);
+        super::frames::dot(u, w) / super::frames::norm(super::frames::cross(u, w))
+    })
+}

@@ -1,0 +1,98 @@
+//! Small synthetic meshes for the cone-placement tests.
+
+use crate::mesh::TriMesh;
+
+/// A regular octahedron (six degree-4 vertices, each a cone of angle 2pi - pi/2).
+pub fn octahedron() -> TriMesh {
+    let p = vec![[1., 0., 0.], [-1., 0., 0.], [0., 1., 0.], [0., -1., 0.], [0., 0., 1.], [0., 0., -1.]];
+    let t = vec![[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    TriMesh::from_welded_arrays(p, t).unwrap()
+}
+
+/// An `nx` × `ny` grid of squares on [0, 1]², each split into two
+/// triangles, mapped through `embed`.
+pub fn grid(nx: usize, ny: usize, embed: impl Fn(f64, f64) -> [f64; 3]) -> TriMesh {
+    let mut p = Vec::new();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            p.push(embed(i as f64 / nx as f64, j as f64 / ny as f64));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut t = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                t.push([a, b, c]);
+                t.push([a, c, d]);
+            } else {
+                t.push([a, b, d]);
+                t.push([b, c, d]);
+            }
+        }
+    }
+    TriMesh::from_welded_arrays(p, t).unwrap()
+}
+
+/// A torus of revolution with `nu` × `nv` quads split in two.
+pub fn torus(nu: usize, nv: usize, big_r: f64, small_r: f64) -> TriMesh {
+    use std::f64::consts::PI;
+    let mut p = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            let (u, v) = (2.0 * PI * i as f64 / nu as f64, 2.0 * PI * j as f64 / nv as f64);
+            let r = big_r + small_r * v.cos();
+            p.push([r * u.cos(), r * u.sin(), small_r * v.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((j % nv) * nu + (i % nu)) as u32;
+    let mut t = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            t.push([a, b, c]);
+            t.push([a, c, d]);
+        }
+    }
+    TriMesh::from_welded_arrays(p, t).unwrap()
+}
+
+/// A flat square annulus: the square [-1, 1]² minus the square of half-side
+/// `inner` rotated by `angle`, triangulated by a polar-like grid of
+/// `n` segments per side and `rings` rings.
+pub fn square_annulus(n: usize, rings: usize, inner: f64, angle: f64) -> TriMesh {
+    let square = |s: f64, half: f64, rot: f64| -> [f64; 2] {
+        // Point at arclength fraction s in [0, 1) around a square of half-side `half`.
+        let side = (s * 4.0).floor() as usize % 4;
+        let f = s * 4.0 - (s * 4.0).floor();
+        let (x, y) = match side {
+            0 => (-half + 2.0 * half * f, -half),
+            1 => (half, -half + 2.0 * half * f),
+            2 => (half - 2.0 * half * f, half),
+            _ => (-half, half - 2.0 * half * f),
+        };
+        [x * rot.cos() - y * rot.sin(), x * rot.sin() + y * rot.cos()]
+    };
+    let m = 4 * n;
+    let mut p = Vec::new();
+    for r in 0..=rings {
+        let t = r as f64 / rings as f64;
+        for i in 0..m {
+            let s = i as f64 / m as f64;
+            let a = square(s, 1.0, 0.0);
+            let b = square(s, inner, angle);
+            p.push([a[0] * (1.0 - t) + b[0] * t, a[1] * (1.0 - t) + b[1] * t, 0.0]);
+        }
+    }
+    let id = |r: usize, i: usize| (r * m + i % m) as u32;
+    let mut t = Vec::new();
+    for r in 0..rings {
+        for i in 0..m {
+            let (a, b, c, d) = (id(r, i), id(r, i + 1), id(r + 1, i + 1), id(r + 1, i));
+            t.push([a, b, c]);
+            t.push([a, c, d]);
+        }
+    }
+    TriMesh::from_welded_arrays(p, t).unwrap()
+}

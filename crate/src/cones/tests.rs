@@ -1,0 +1,70 @@
+//! Cone placement on synthetic shapes with known answers.
+
+use super::test_meshes::{grid, octahedron, square_annulus, torus};
+use super::*;
+use crate::features::FeatureSet;
+
+fn run(mesh: &TriMesh, alpha: f64, miq: bool) -> ConePlacement {
+    let options = ConeOptions { alpha_smooth: alpha, miq, ..ConeOptions::default() };
+    place_cones(mesh, &FeatureSet::none(mesh), &options, &mut |_| {}).unwrap()
+}
+
+fn assert_gauss_bonnet(mesh: &TriMesh, r: &ConePlacement) {
+    for c in &r.components {
+        assert_eq!(c.k_sum, 4 * c.euler_characteristic, "sum of k is 4 chi per component");
+        assert!(c.residual < 1e-8, "residual {}", c.residual);
+    }
+    let total: i32 = r.cones.iter().chain(&r.boundary_corners).map(|c| c.k).sum();
+    assert_eq!(total as i64, 4 * mesh.euler_characteristic());
+}
+
+#[test]
+fn flat_square_has_four_corners_and_no_cones() {
+    let mesh = grid(8, 8, |x, y| [x, y, 0.0]);
+    let r = run(&mesh, DEFAULT_ALPHA, false);
+    assert_gauss_bonnet(&mesh, &r);
+    assert!(r.cones.is_empty(), "cones: {:?}", r.cones);
+    assert_eq!(r.boundary_corners.len(), 4);
+    assert!(r.boundary_corners.iter().all(|c| c.k == 1));
+    assert!(r.phi.iter().all(|p| p.abs() < 1e-8), "max |phi| {}", r.phi.iter().fold(0.0f64, |m, p| m.max(p.abs())));
+}
+
+#[test]
+fn octahedron_gets_eight_quarter_turns() {
+    let mesh = octahedron();
+    let r = run(&mesh, DEFAULT_ALPHA, false);
+    assert_gauss_bonnet(&mesh, &r);
+    assert_eq!(r.cones.iter().map(|c| c.k).sum::<i32>(), 8);
+}
+
+#[test]
+fn torus_has_two_homology_loops_and_balanced_cones() {
+    let mesh = torus(24, 12, 2.0, 0.7);
+    let r = run(&mesh, 100.0, false);
+    assert_gauss_bonnet(&mesh, &r);
+    assert_eq!(r.components[0].path_integers.len(), 2, "two homology loops");
+    assert_eq!(r.cones.iter().map(|c| c.k).sum::<i32>(), 0);
+    // Known shortfall (see the issue note): the greedy rounding leaves cone
+    // pairs on the torus of revolution at alpha = 100 although a cone-free
+    // solution has lower energy.
+}
+
+#[test]
+fn axis_aligned_annulus_is_flat_without_cones() {
+    let mesh = square_annulus(4, 3, 0.4, 0.0);
+    let r = run(&mesh, DEFAULT_ALPHA, false);
+    assert_gauss_bonnet(&mesh, &r);
+    assert!(r.cones.is_empty(), "cones: {:?}", r.cones);
+    assert_eq!(r.boundary_corners.iter().filter(|c| c.k == 1).count(), 4);
+    assert_eq!(r.boundary_corners.iter().filter(|c| c.k == -1).count(), 4);
+    assert!(r.phi.iter().all(|p| p.abs() < 1e-8));
+}
+
+#[test]
+fn rotated_annulus_absorbs_the_rotation_with_cones() {
+    let mesh = square_annulus(6, 4, 0.4, 30f64.to_radians());
+    let r = run(&mesh, DEFAULT_ALPHA, false);
+    assert_gauss_bonnet(&mesh, &r);
+    assert!(!r.cones.is_empty(), "a 30 degree misalignment needs cones");
+    assert_eq!(r.components[0].path_integers.len(), 1, "one alignment path between the two loops");
+}

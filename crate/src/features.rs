@@ -1,0 +1,327 @@
+//! Feature curves: which edges the parametrization must align with, and the
+//! mesh cut open along them so every feature becomes a boundary curve
+//! (paper section 4: "we cut the mesh along feature curves converting each
+//! curve into two boundary curves").
+
+use crate::mesh::{TriMesh, NONE};
+use crate::operators;
+use std::collections::HashMap;
+use std::fmt;
+
+/// Feature edges of a [`TriMesh`], one flag per edge (boundary edges are
+/// never flagged: they are aligned anyway).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FeatureSet {
+    is_feature: Vec<bool>,
+}
+
+/// Why a feature list could not be applied to a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FeatureError {
+    /// An end point of feature edge `index` matches no mesh vertex.
+    NoVertexAt { index: usize, position: [f64; 3] },
+    /// Both end points of feature edge `index` match vertices that share no edge.
+    NotAnEdge { index: usize, vertices: [u32; 2] },
+}
+
+impl fmt::Display for FeatureError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FeatureError::NoVertexAt { index, position: p } => {
+                write!(f, "feature edge {index}: no mesh vertex at ({}, {}, {})", p[0], p[1], p[2])
+            }
+            FeatureError::NotAnEdge { index, vertices: v } => {
+                write!(f, "feature edge {index}: vertices v{} and v{} are not joined by an edge", v[0], v[1])
+            }
+        }
+    }
+}
+
+impl std::error::Error for FeatureError {}
+
+impl FeatureSet {
+    /// No features.
+    pub fn none(mesh: &TriMesh) -> FeatureSet {
+        FeatureSet { is_feature: vec![false; mesh.n_edges()] }
+    }
+
+    /// Interior edges whose dihedral angle (angle between the two face
+    /// normals) exceeds `threshold_degrees`.
+    pub fn sharp_edges(mesh: &TriMesh, threshold_degrees: f64) -> FeatureSet {
+        let threshold = threshold_degrees.to_radians();
+        let mut set = FeatureSet::none(mesh);
+        let normals = operators::face_normals(mesh.positions(), mesh.faces());
+        for e in 0..mesh.n_edges() as u32 {
+            let [h, t] = mesh.edge_halfedges(e);
+            if let (Some(f), Some(g)) = (mesh.face(h), mesh.face(t)) {
+                let (a, b) = (normals[f as usize], normals[g as usize]);
+                let cos = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).clamp(-1.0, 1.0);
+                set.is_feature[e as usize] = cos.acos() > threshold;
+            }
+        }
+        set
+    }
+
+    /// Edges given by the positions of their end points (so the list does not
+    /// depend on vertex numbering); a position matches the nearest vertex
+    /// within `1e-6` of the bounding-box diagonal.
+    pub fn from_positions(mesh: &TriMesh, edges: &[[[f64; 3]; 2]]) -> Result<FeatureSet, FeatureError> {
+        let locator = VertexLocator::new(mesh.positions());
+        let mut set = FeatureSet::none(mesh);
+        for (index, [p, q]) in edges.iter().enumerate() {
+            let find = |x: &[f64; 3]| locator.find(x).ok_or(FeatureError::NoVertexAt { index, position: *x });
+            let (a, b) = (find(p)?, find(q)?);
+            let e = mesh
+                .outgoing(a)
+                .find(|&h| mesh.head(h) == b)
+                .map(|h| mesh.edge(h))
+                .ok_or(FeatureError::NotAnEdge { index, vertices: [a, b] })?;
+            set.set(mesh, e, true);
+        }
+        Ok(set)
+    }
+
+    /// Marks (or unmarks) edge `e`; boundary edges stay unmarked.
+    pub fn set(&mut self, mesh: &TriMesh, e: u32, on: bool) {
+        self.is_feature[e as usize] = on && !mesh.is_boundary_edge(e);
+    }
+
+    /// Adds every feature of `other` (same mesh).
+    pub fn union(&mut self, other: &FeatureSet) {
+        for (a, b) in self.is_feature.iter_mut().zip(&other.is_feature) {
+            *a |= *b;
+        }
+    }
+
+    /// True when edge `e` is a feature.
+    pub fn contains(&self, e: u32) -> bool {
+        self.is_feature[e as usize]
+    }
+
+    /// Number of feature edges.
+    pub fn len(&self) -> usize {
+        self.is_feature.iter().filter(|&&f| f).count()
+    }
+
+    /// True when there is no feature edge.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The feature edges, ascending.
+    pub fn edges(&self) -> impl Iterator<Item = u32> + '_ {
+        self.is_feature.iter().enumerate().filter(|(_, &f)| f).map(|(e, _)| e as u32)
+    }
+}
+
+/// A mesh cut open along its feature edges.
+#[derive(Clone, Debug)]
+pub struct CutMesh {
+    /// The cut mesh: each feature edge became two boundary edges.
+    pub mesh: TriMesh,
+    /// Cut vertex → vertex of the original mesh.
+    pub original_vertex: Vec<u32>,
+    /// Cut edge → edge of the original mesh.
+    pub original_edge: Vec<u32>,
+}
+
+impl CutMesh {
+    /// True when boundary edge `e` of the cut mesh comes from a feature
+    /// (rather than from a boundary of the original mesh).
+    pub fn is_feature_edge(&self, original: &TriMesh, e: u32) -> bool {
+        self.mesh.is_boundary_edge(e) && !original.is_boundary_edge(self.original_edge[e as usize])
+    }
+}
+
+/// Cuts `mesh` open along `features`: the corners around each vertex are
+/// split into the sectors separated by feature edges, one new vertex per
+/// sector. Faces keep their indices. An isolated feature edge whose two ends
+/// are interior and touch no other feature cannot be opened (it would become
+/// two edges between the same two vertices) and is left closed.
+pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
+    let mut degree = vec![0u32; mesh.n_vertices()];
+    for e in features.edges() {
+        for v in mesh.edge_vertices(e) {
+            degree[v as usize] += 1;
+        }
+    }
+    let splits = |v: u32| degree[v as usize] >= 2 || mesh.is_boundary_vertex(v);
+    let is_cut = |e: u32| features.contains(e) && mesh.edge_vertices(e).iter().any(|&v| splits(v));
+    // Union corners (3 f + k) across every interior non-feature edge.
+    let n_corners = 3 * mesh.n_faces();
+    let mut parent: Vec<u32> = (0..n_corners as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            parent[x as usize] = parent[parent[x as usize] as usize];
+            x = parent[x as usize];
+        }
+        x
+    }
+    for e in 0..mesh.n_edges() as u32 {
+        if is_cut(e) || mesh.is_boundary_edge(e) {
+            continue;
+        }
+        let [h, t] = mesh.edge_halfedges(e);
+        // Halfedge h = 3f + k runs corner k -> k + 1; its twin runs the other way.
+        let (ht, hh) = (h, 3 * (h / 3) + (h % 3 + 1) % 3);
+        let (tt, th) = (t, 3 * (t / 3) + (t % 3 + 1) % 3);
+        for (a, b) in [(ht, th), (hh, tt)] {
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            parent[ra as usize] = rb;
+        }
+    }
+    let mut new_id = vec![NONE; n_corners];
+    let mut original_vertex = Vec::new();
+    let mut faces = Vec::with_capacity(mesh.n_faces());
+    for (f, tri) in mesh.faces().iter().enumerate() {
+        let mut out = [0u32; 3];
+        for k in 0..3 {
+            let r = find(&mut parent, (3 * f + k) as u32) as usize;
+            if new_id[r] == NONE {
+                new_id[r] = original_vertex.len() as u32;
+                original_vertex.push(tri[k]);
+            }
+            out[k] = new_id[r];
+        }
+        faces.push(out);
+    }
+    let positions = original_vertex.iter().map(|&v| mesh.position(v)).collect();
+    let cut = TriMesh::from_welded_arrays(positions, faces)
+        .expect("cutting a valid mesh along edges keeps it manifold and oriented");
+    let original_edge = (0..cut.n_edges() as u32)
+        .map(|e| {
+            let h = cut.edge_halfedges(e)[0];
+            mesh.edge(h) // face halfedge numbering is shared (3 f + k)
+        })
+        .collect();
+    CutMesh { mesh: cut, original_vertex, original_edge }
+}
+
+/// Finds mesh vertices by position with a uniform hash grid.
+struct VertexLocator<'a> {
+    positions: &'a [[f64; 3]],
+    cell: f64,
+    origin: [f64; 3],
+    grid: HashMap<[i64; 3], Vec<u32>>,
+    tolerance: f64,
+}
+
+impl<'a> VertexLocator<'a> {
+    fn new(positions: &'a [[f64; 3]]) -> Self {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in positions {
+            for i in 0..3 {
+                lo[i] = lo[i].min(p[i]);
+                hi[i] = hi[i].max(p[i]);
+            }
+        }
+        let diag = ((0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>()).sqrt().max(f64::MIN_POSITIVE);
+        let tolerance = 1e-6 * diag;
+        let cell = 4.0 * tolerance;
+        let mut locator = VertexLocator { positions, cell, origin: lo, grid: HashMap::new(), tolerance };
+        for (v, p) in positions.iter().enumerate() {
+            let key = locator.key(p);
+            locator.grid.entry(key).or_default().push(v as u32);
+        }
+        locator
+    }
+
+    fn key(&self, p: &[f64; 3]) -> [i64; 3] {
+        [0, 1, 2].map(|i| ((p[i] - self.origin[i]) / self.cell).floor() as i64)
+    }
+
+    /// The nearest vertex within the tolerance, if any.
+    fn find(&self, p: &[f64; 3]) -> Option<u32> {
+        let k = self.key(p);
+        let mut best: Option<(f64, u32)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &v in self.grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]).into_iter().flatten() {
+                        let q = self.positions[v as usize];
+                        let d = ((0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>()).sqrt();
+                        if d <= self.tolerance && best.map_or(true, |(bd, _)| d < bd) {
+                            best = Some((d, v));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, v)| v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit cube of 12 triangles: every edge between two cube faces is sharp.
+    fn cube() -> TriMesh {
+        let p = [
+            [0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.],
+            [0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.],
+        ];
+        let quads = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
+        let tris = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+        TriMesh::from_welded_arrays(p.to_vec(), tris).unwrap()
+    }
+
+    #[test]
+    fn cube_sharp_edges_are_the_twelve_cube_edges() {
+        let m = cube();
+        let s = FeatureSet::sharp_edges(&m, 60.0);
+        assert_eq!(s.len(), 12);
+        assert_eq!(FeatureSet::sharp_edges(&m, 95.0).len(), 0);
+    }
+
+    #[test]
+    fn cutting_the_cube_along_its_edges_gives_six_squares() {
+        let m = cube();
+        let cut = cut_open(&m, &FeatureSet::sharp_edges(&m, 60.0));
+        assert_eq!(cut.mesh.n_components(), 6);
+        assert_eq!(cut.mesh.n_vertices(), 24);
+        assert_eq!(cut.mesh.boundary_loops().len(), 6);
+        for c in 0..6 {
+            assert_eq!(cut.mesh.component_euler_characteristic(c), 1);
+        }
+        for (v, &o) in cut.original_vertex.iter().enumerate() {
+            assert_eq!(cut.mesh.position(v as u32), m.position(o));
+        }
+        for e in 0..cut.mesh.n_edges() as u32 {
+            let [a, b] = cut.mesh.edge_vertices(e);
+            let mut orig = m.edge_vertices(cut.original_edge[e as usize]);
+            let mut mapped = [cut.original_vertex[a as usize], cut.original_vertex[b as usize]];
+            orig.sort();
+            mapped.sort();
+            assert_eq!(orig, mapped);
+        }
+    }
+
+    #[test]
+    fn a_feature_chain_opens_a_slit_and_a_lone_edge_stays_closed() {
+        let m = cube();
+        let mut lone = FeatureSet::none(&m);
+        lone.set(&m, 0, true);
+        let cut = cut_open(&m, &lone);
+        assert_eq!(cut.mesh.n_vertices(), 8);
+        assert!(cut.mesh.boundary_loops().is_empty(), "a lone interior edge cannot be opened");
+        // Two cube edges meeting at vertex 0: (0, 1) and (0, 3).
+        let chain = FeatureSet::from_positions(&m, &[[[1., 0., 0.], [0., 0., 0.]], [[0., 0., 0.], [0., 1., 0.]]]).unwrap();
+        let cut = cut_open(&m, &chain);
+        assert_eq!(cut.mesh.n_vertices(), 9, "the middle vertex of the chain splits in two");
+        assert_eq!(cut.mesh.boundary_loops().len(), 1);
+        assert_eq!(cut.mesh.euler_characteristic(), 1);
+    }
+
+    #[test]
+    fn features_by_position_match_vertices_and_reject_strangers() {
+        let m = cube();
+        let s = FeatureSet::from_positions(&m, &[[[0., 0., 0.], [1., 0., 0.]]]).unwrap();
+        assert_eq!(s.len(), 1);
+        let far = FeatureSet::from_positions(&m, &[[[0.5, 0.5, 0.5], [1., 0., 0.]]]);
+        assert!(matches!(far, Err(FeatureError::NoVertexAt { index: 0, .. })));
+        let diagonal = FeatureSet::from_positions(&m, &[[[0., 0., 0.], [1., 1., 1.]]]);
+        assert!(matches!(diagonal, Err(FeatureError::NotAnEdge { index: 0, .. })));
+    }
+}
