@@ -2,9 +2,11 @@
 //!
 //! Errors cross as JS `Error`s carrying the library's one-line message.
 
+use crate::cones::{self, ConeOptions, Progress};
+use crate::features::FeatureSet;
 use crate::io::{self, InputFile};
-use crate::mesh;
-use js_sys::{Array, Float32Array, Object, Reflect, Uint32Array, Uint8Array};
+use crate::mesh::{self, MeshReport, RawMesh, TriMesh};
+use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, Uint8Array};
 use wasm_bindgen::prelude::*;
 
 /// Library version, for the page's about line.
@@ -19,21 +21,163 @@ pub fn version() -> String {
 /// vertices, or throws an `Error` naming the problem.
 #[wasm_bindgen]
 pub fn import_mesh(files: Array) -> Result<JsValue, JsError> {
-    let files = input_files(&files)?;
-    let (main, others) = files.split_first().ok_or_else(|| JsError::new("no file given"))?;
-    let raw = io::import(main, others).map_err(|e| JsError::new(&e.to_string()))?;
-    let report = mesh::analyze(&raw);
-    let welded = mesh::weld(&raw);
-    let positions: Vec<f32> = welded.positions.iter().flat_map(|p| p.map(|c| c as f32)).collect();
-    let indices: Vec<u32> = welded.triangles.iter().flatten().copied().collect();
-    let messages: Array = report.problems.iter().map(|p| JsValue::from(p.to_string())).collect();
+    let session = MeshSession::open(files)?;
     let out = Object::new();
-    let report_js = serde_wasm_bindgen::to_value(&report).map_err(|e| JsError::new(&e.to_string()))?;
-    set(&report_js.clone().into(), "problem_messages", &messages.into())?;
-    set(&out, "report", &report_js)?;
-    set(&out, "positions", &Float32Array::from(&positions[..]).into())?;
-    set(&out, "indices", &Uint32Array::from(&indices[..]).into())?;
+    set(&out, "report", &session.report()?)?;
+    set(&out, "positions", &session.positions().into())?;
+    set(&out, "indices", &session.indices().into())?;
     Ok(out.into())
+}
+
+/// An imported mesh kept in the worker between requests: its report, its
+/// welded geometry and, when it has no blocking problem, the validated
+/// [`TriMesh`] that cone placement and parametrization run on.
+#[wasm_bindgen]
+pub struct MeshSession {
+    #[allow(dead_code)]
+    raw: RawMesh,
+    report: MeshReport,
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    mesh: Option<TriMesh>,
+}
+
+#[wasm_bindgen]
+impl MeshSession {
+    /// Imports `files` (as for [`import_mesh`]); throws on unreadable input.
+    /// A mesh with problems still opens: see `report()` and `is_valid()`.
+    pub fn open(files: Array) -> Result<MeshSession, JsError> {
+        let files = input_files(&files)?;
+        let (main, others) = files.split_first().ok_or_else(|| JsError::new("no file given"))?;
+        let raw = io::import(main, others).map_err(|e| JsError::new(&e.to_string()))?;
+        let report = mesh::analyze(&raw);
+        let mesh = TriMesh::from_raw(&raw).ok();
+        let (positions, triangles) = match &mesh {
+            Some(m) => (m.positions().to_vec(), m.faces().to_vec()),
+            None => {
+                let w = mesh::weld(&raw);
+                (w.positions, w.triangles)
+            }
+        };
+        Ok(MeshSession { raw, report, positions, triangles, mesh })
+    }
+
+    /// The mesh report (`MeshReport` plus `problem_messages`, one line each).
+    pub fn report(&self) -> Result<JsValue, JsError> {
+        let value = serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))?;
+        let messages: Array = self.report.problems.iter().map(|p| JsValue::from(p.to_string())).collect();
+        set(&value.clone().into(), "problem_messages", &messages.into())?;
+        Ok(value)
+    }
+
+    /// True when the mesh has no blocking problem (cones and UVs can be computed).
+    pub fn is_valid(&self) -> bool {
+        self.mesh.is_some()
+    }
+
+    /// Welded vertex positions, xyz per vertex.
+    pub fn positions(&self) -> Float32Array {
+        let v: Vec<f32> = self.positions.iter().flat_map(|p| p.map(|c| c as f32)).collect();
+        Float32Array::from(&v[..])
+    }
+
+    /// Triangles as welded vertex indices, 3 per face.
+    pub fn indices(&self) -> Uint32Array {
+        let v: Vec<u32> = self.triangles.iter().flatten().copied().collect();
+        Uint32Array::from(&v[..])
+    }
+
+    /// Edges of the valid mesh, 2 vertex indices per edge; edge `i` is the
+    /// id used by `sharp_edges`, `boundary_edges` and `place_cones`. Empty
+    /// for an invalid mesh.
+    pub fn edges(&self) -> Uint32Array {
+        let v: Vec<u32> = match &self.mesh {
+            Some(m) => (0..m.n_edges() as u32).flat_map(|e| m.edge_vertices(e)).collect(),
+            None => Vec::new(),
+        };
+        Uint32Array::from(&v[..])
+    }
+
+    /// Ids of the boundary edges.
+    pub fn boundary_edges(&self) -> Uint32Array {
+        let v: Vec<u32> = match &self.mesh {
+            Some(m) => (0..m.n_edges() as u32).filter(|&e| m.is_boundary_edge(e)).collect(),
+            None => Vec::new(),
+        };
+        Uint32Array::from(&v[..])
+    }
+
+    /// Ids of the interior edges whose dihedral angle exceeds `degrees`.
+    pub fn sharp_edges(&self, degrees: f64) -> Uint32Array {
+        let v: Vec<u32> = match &self.mesh {
+            Some(m) => FeatureSet::sharp_edges(m, degrees).edges().collect(),
+            None => Vec::new(),
+        };
+        Uint32Array::from(&v[..])
+    }
+
+    /// Places cones with `feature_edges` (edge ids) as features.
+    /// `progress(stage: string, step: number, remaining: number)` is called
+    /// per topology step, rounding round and cone-move pass. Returns
+    /// `{cones, boundary_corners, components, rounds, energy, phi_rms, timings}`.
+    pub fn place_cones(
+        &self,
+        feature_edges: &[u32],
+        alpha_smooth: f64,
+        miq: bool,
+        progress: &Function,
+    ) -> Result<JsValue, JsError> {
+        let mesh = self.valid_mesh()?;
+        let features = self.features(mesh, feature_edges)?;
+        let (lo, hi) = cones::ALPHA_RANGE;
+        if !(lo..=hi).contains(&alpha_smooth) {
+            return Err(JsError::new(&format!("alpha_smooth {alpha_smooth} is outside {lo}..{hi}")));
+        }
+        let options = ConeOptions { alpha_smooth, miq, ..ConeOptions::default() };
+        let mut report = |p: Progress| {
+            let (stage, a, b) = match p {
+                Progress::Topology { component, components } => ("topology", component, components),
+                Progress::Rounding { round, free, .. } => ("rounding", round, free),
+                Progress::ConeMoves { pass, .. } => ("cone moves", pass, 0),
+            };
+            let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
+        };
+        let r = cones::place_cones(mesh, &features, &options, &mut report).map_err(|e| JsError::new(&e.to_string()))?;
+        let out = Object::new();
+        set(&out, "cones", &to_js(&r.cones)?)?;
+        set(&out, "boundary_corners", &to_js(&r.boundary_corners)?)?;
+        set(&out, "components", &to_js(&r.components)?)?;
+        set(&out, "rounds", &(r.rounds as f64).into())?;
+        set(&out, "energy", &r.energy.into())?;
+        set(&out, "phi_rms", &r.phi_rms.into())?;
+        set(&out, "timings", &to_js(&r.timings)?)?;
+        set(&out, "feature_edges", &(features.len() as f64).into())?;
+        Ok(out.into())
+    }
+}
+
+impl MeshSession {
+    fn valid_mesh(&self) -> Result<&TriMesh, JsError> {
+        self.mesh.as_ref().ok_or_else(|| {
+            let first = self.report.problems.iter().find(|p| p.is_blocking()).map(|p| p.to_string()).unwrap_or_default();
+            JsError::new(&format!("this mesh cannot be parametrized: {first}"))
+        })
+    }
+
+    fn features(&self, mesh: &TriMesh, edges: &[u32]) -> Result<FeatureSet, JsError> {
+        let mut set = FeatureSet::none(mesh);
+        for &e in edges {
+            if e as usize >= mesh.n_edges() {
+                return Err(JsError::new(&format!("feature edge id {e} is out of range ({} edges)", mesh.n_edges())));
+            }
+            set.set(mesh, e, true);
+        }
+        Ok(set)
+    }
+}
+
+fn to_js<T: serde::Serialize>(value: &T) -> Result<JsValue, JsError> {
+    serde_wasm_bindgen::to_value(value).map_err(|e| JsError::new(&e.to_string()))
 }
 
 fn input_files(files: &Array) -> Result<Vec<InputFile>, JsError> {

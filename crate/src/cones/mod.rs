@@ -97,6 +97,8 @@ pub struct ComponentCones {
     pub moves: usize,
     /// Relative residual of the final KKT solve.
     pub residual: f64,
+    /// Iterative-refinement steps over all solves.
+    pub refinement_steps: usize,
 }
 
 /// The result of cone placement.
@@ -204,6 +206,7 @@ pub fn place_cones(
             rounds: sys.rounds,
             moves,
             residual: sys.residual,
+            refinement_steps: sys.refinement_steps,
         });
     }
     let (cones, boundary_corners) = original_cones(mesh, &cut, &k);

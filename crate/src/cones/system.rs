@@ -74,6 +74,8 @@ pub struct ComponentSystem<'a> {
     pub x: Vec<f64>,
     pub residual: f64,
     pub rounds: usize,
+    /// Iterative-refinement steps over all solves (a conditioning diagnostic).
+    pub refinement_steps: usize,
 }
 
 /// What went wrong while placing cones.
@@ -299,6 +301,7 @@ impl<'a> ComponentSystem<'a> {
             x: Vec::new(),
             residual: f64::NAN,
             rounds: 0,
+            refinement_steps: 0,
         })
     }
 
@@ -321,6 +324,7 @@ impl<'a> ComponentSystem<'a> {
         let mut b = vec![0.0; self.n];
         b.extend_from_slice(&self.constraint_rhs);
         let (x, info) = self.solver.solve_with_info(&b)?;
+        self.refinement_steps += info.refinement_steps;
         self.x = x;
         self.residual = info.relative_residual;
         Ok(())
@@ -439,17 +443,22 @@ impl<'a> ComponentSystem<'a> {
 
     /// Cone-location optimization (section 5.3): moves each interior cone to
     /// the neighbouring interior vertex that lowers `phiᵀ M phi / A` most,
-    /// until no move helps or `max_passes` passes. Returns the moves made.
+    /// until no move helps or `max_passes` passes. After the first pass only
+    /// cones near a cone that moved are reconsidered. Returns the moves made.
     pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
         let mut moves = 0;
         let mut current = self.phi_norm2();
+        let nv = self.tree.vertices.len();
+        // Cones to (re)consider, as local vertices; all of them at first.
+        let mut dirty = vec![true; nv];
         for pass in 0..max_passes {
             progress(pass);
-            let mut improved = false;
             let k = self.vertex_k();
-            let cones: Vec<usize> = (0..k.len())
-                .filter(|&i| k[i] != 0 && !self.mesh.is_boundary_vertex(self.tree.vertices[i]))
+            let cones: Vec<usize> = (0..nv)
+                .filter(|&i| k[i] != 0 && dirty[i] && !self.mesh.is_boundary_vertex(self.tree.vertices[i]))
                 .collect();
+            dirty.iter_mut().for_each(|d| *d = false);
+            let mut moved = Vec::new();
             for i in cones {
                 let ki = self.vertex_k()[i];
                 if ki == 0 {
@@ -476,14 +485,25 @@ impl<'a> ComponentSystem<'a> {
                     self.transfer(i, j, ki);
                     current = e;
                     moves += 1;
-                    improved = true;
+                    moved.push(j);
                 }
             }
-            self.solve()?;
-            if !improved {
+            if moved.is_empty() {
                 break;
             }
+            // Reconsider cones within two rings of a moved cone.
+            for &j in &moved {
+                let v = self.tree.vertices[j];
+                dirty[j] = true;
+                for w in self.mesh.one_ring(v) {
+                    dirty[self.local[w as usize] as usize] = true;
+                    for x in self.mesh.one_ring(w) {
+                        dirty[self.local[x as usize] as usize] = true;
+                    }
+                }
+            }
         }
+        self.solve()?;
         Ok(moves)
     }
 }

@@ -96,3 +96,38 @@ pub fn square_annulus(n: usize, rings: usize, inner: f64, angle: f64) -> TriMesh
     }
     TriMesh::from_welded_arrays(p, t).unwrap()
 }
+
+/// The ring-with-flap shape of the paper's Figure 10: a circular strip ring
+/// (radii 1 to 1.5) with a radial flap (out to radius 2.5, about 0.35 wide)
+/// protruding from its outer side; `n` cells around the ring.
+pub fn ring_with_flap(n: usize) -> TriMesh {
+    use std::collections::HashMap;
+    use std::f64::consts::PI;
+    let radii = [1.0, 1.125, 1.25, 1.375, 1.5, 1.75, 2.0, 2.25, 2.5];
+    let ring_rows = 4; // rows 0..4 are the ring, rows 4..8 the flap
+    let flap_cells = 2; // cells on each side of angle 0
+    let mut id: HashMap<(usize, usize), u32> = HashMap::new();
+    let mut p: Vec<[f64; 3]> = Vec::new();
+    let mut vert = |i: usize, j: usize, p: &mut Vec<[f64; 3]>| {
+        let i = i % n;
+        *id.entry((i, j)).or_insert_with(|| {
+            let a = 2.0 * PI * i as f64 / n as f64;
+            p.push([radii[j] * a.cos(), radii[j] * a.sin(), 0.0]);
+            (p.len() - 1) as u32
+        })
+    };
+    let mut t = Vec::new();
+    for j in 0..radii.len() - 1 {
+        for i in 0..n {
+            let in_flap = i < flap_cells || i >= n - flap_cells;
+            if j >= ring_rows && !in_flap {
+                continue;
+            }
+            let (a, b) = (vert(i, j, &mut p), vert(i + 1, j, &mut p));
+            let (c, d) = (vert(i + 1, j + 1, &mut p), vert(i, j + 1, &mut p));
+            t.push([a, b, c]);
+            t.push([a, c, d]);
+        }
+    }
+    TriMesh::from_welded_arrays(p, t).unwrap()
+}

@@ -68,3 +68,16 @@ fn rotated_annulus_absorbs_the_rotation_with_cones() {
     assert!(!r.cones.is_empty(), "a 30 degree misalignment needs cones");
     assert_eq!(r.components[0].path_integers.len(), 1, "one alignment path between the two loops");
 }
+
+#[test]
+fn ring_with_flap_gets_cones_where_miq_emulation_gets_none() {
+    // Figure 10: boundary alignment forces a cone-free map to collapse the flap.
+    let mesh = super::test_meshes::ring_with_flap(72);
+    assert_eq!(mesh.boundary_loops().len(), 2);
+    let ours = run(&mesh, DEFAULT_ALPHA, false);
+    assert_gauss_bonnet(&mesh, &ours);
+    let miq = run(&mesh, MIQ_ALPHA, true);
+    assert_gauss_bonnet(&mesh, &miq);
+    assert!(miq.cones.is_empty(), "MIQ emulation: {:?}", miq.cones);
+    assert!(!ours.cones.is_empty(), "the method must place cones to avoid the collapse");
+}

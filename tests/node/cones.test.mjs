@@ -1,0 +1,63 @@
+// Cone placement through the wasm build (the page's worker calls the same API).
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import path from 'node:path';
+import { test } from 'node:test';
+import { committedFandisk, loadWasm, sharedMesh } from './wasm.mjs';
+
+const wasm = loadWasm();
+const open = (file) =>
+  wasm.MeshSession.open([{ name: path.basename(file), bytes: new Uint8Array(fs.readFileSync(file)) }]);
+const sumK = (r) => [...r.cones, ...r.boundary_corners].reduce((s, c) => s + c.k, 0);
+
+test('fandisk with sharp features: Gauss-Bonnet, progress by round, exact constraints', () => {
+  const session = open(committedFandisk);
+  assert.equal(session.is_valid(), true);
+  const edges = session.edges();
+  const sharp = session.sharp_edges(60);
+  assert.ok(sharp.length > 0 && sharp.length < edges.length / 2);
+  const stages = new Set();
+  let roundingCalls = 0;
+  const r = session.place_cones(sharp, 0.01, false, (stage) => {
+    stages.add(stage);
+    if (stage === 'rounding') roundingCalls += 1;
+  });
+  assert.deepEqual([...stages].sort(), ['cone moves', 'rounding', 'topology']);
+  assert.equal(r.feature_edges, sharp.length);
+  assert.equal(sumK(r), 4 * 2, 'sum of k = 4 chi');
+  for (const c of r.components) {
+    assert.equal(c.k_sum, 4 * c.euler_characteristic);
+    assert.ok(c.residual < 1e-8, `residual ${c.residual}`);
+  }
+  // One report after every solve: the first one and one per rounding round, per component.
+  assert.equal(roundingCalls, r.rounds + r.components.length);
+  assert.ok(r.cones.length > 10 && r.cones.length < 200, `${r.cones.length} cones`);
+  for (const c of r.cones) assert.ok(Number.isInteger(c.k) && c.k !== 0 && c.position.length === 3);
+});
+
+test('woody (open surface): boundary corners and cones add up to 4 chi', (t) => {
+  const file = sharedMesh('woody');
+  if (!file) return t.skip('shared meshes not present');
+  const r = open(file).place_cones(new Uint32Array(), 0.01, false, () => {});
+  assert.equal(sumK(r), 4);
+  assert.ok(r.boundary_corners.length > 0);
+});
+
+test('MIQ emulation runs on the same mesh', () => {
+  const session = open(committedFandisk);
+  const r = session.place_cones(session.sharp_edges(60), 100, true, () => {});
+  assert.equal(sumK(r), 8);
+});
+
+test('bad requests give readable errors, not crashes', (t) => {
+  const session = open(committedFandisk);
+  assert.throws(() => session.place_cones(new Uint32Array(), 1e9, false, () => {}), /alpha_smooth .* outside/);
+  assert.throws(() => session.place_cones(new Uint32Array([4e9]), 0.01, false, () => {}), /feature edge id .* out of range/);
+  const beetle = sharedMesh('beetle');
+  if (!beetle) return t.skip('shared meshes not present');
+  const bad = open(beetle);
+  assert.equal(bad.is_valid(), false);
+  assert.throws(() => bad.place_cones(new Uint32Array(), 0.01, false, () => {}), /cannot be parametrized: edge \(v\d+, v\d+\) has \d faces/);
+  // The session still answers after an error.
+  assert.equal(sumK(session.place_cones(session.sharp_edges(60), 0.01, false, () => {})), 8);
+});
