@@ -139,6 +139,7 @@ impl MeshSession {
                 Progress::Topology { component, components } => ("topology", component, components),
                 Progress::Rounding { round, free, .. } => ("rounding", round, free),
                 Progress::ConeMoves { pass, .. } => ("cone moves", pass, 0),
+                Progress::PairCancellation { removed, .. } => ("pair cancellation", removed, 0),
             };
             let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
         };

@@ -42,11 +42,23 @@ pub struct ConeOptions {
     pub optimize_locations: bool,
     /// Cap on cone-move passes.
     pub max_move_passes: usize,
+    /// Cancel opposite cones one or two edges apart (the paper's optional clean-up).
+    pub merge_close_pairs: bool,
+    /// Cancel distant opposite pairs while the objective decreases (0 = off):
+    /// each cone is tried against this many nearest opposite cones.
+    pub cancel_pairs_nearest: usize,
 }
 
 impl Default for ConeOptions {
     fn default() -> Self {
-        ConeOptions { alpha_smooth: DEFAULT_ALPHA, miq: false, optimize_locations: true, max_move_passes: 20 }
+        ConeOptions {
+            alpha_smooth: DEFAULT_ALPHA,
+            miq: false,
+            optimize_locations: true,
+            max_move_passes: 20,
+            merge_close_pairs: true,
+            cancel_pairs_nearest: 3,
+        }
     }
 }
 
@@ -59,6 +71,8 @@ pub enum Progress {
     Rounding { component: usize, round: usize, free: usize },
     /// Cone-location pass `pass`.
     ConeMoves { component: usize, pass: usize },
+    /// Pair cancellation: `removed` pairs so far.
+    PairCancellation { component: usize, removed: usize },
 }
 
 /// A cone or boundary corner: `k` quarter turns of curvature (cone angle
@@ -95,6 +109,9 @@ pub struct ComponentCones {
     pub h: Vec<f64>,
     pub rounds: usize,
     pub moves: usize,
+    /// Opposite cone pairs cancelled by the close-pair clean-up and by descent.
+    pub merged_pairs: usize,
+    pub cancelled_pairs: usize,
     /// Relative residual of the final KKT solve.
     pub residual: f64,
     /// Iterative-refinement steps over all solves.
@@ -168,6 +185,12 @@ pub fn place_cones(
         } else {
             0
         };
+        let merged = if options.merge_close_pairs { sys.merge_close_pairs()? } else { 0 };
+        let cancelled = if options.cancel_pairs_nearest > 0 {
+            sys.cancel_pairs(options.cancel_pairs_nearest, &mut |n| progress(Progress::PairCancellation { component: c, removed: n }))?
+        } else {
+            0
+        };
         timings.cone_moves += clock.lap();
 
         let kv = sys.vertex_k();
@@ -205,6 +228,8 @@ pub fn place_cones(
             h,
             rounds: sys.rounds,
             moves,
+            merged_pairs: merged,
+            cancelled_pairs: cancelled,
             residual: sys.residual,
             refinement_steps: sys.refinement_steps,
         });

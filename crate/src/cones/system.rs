@@ -26,6 +26,8 @@ use std::f64::consts::PI;
 const HARMONIC_WEIGHT: f64 = 1e4;
 /// Proximal weight on the free integers (see the assembly).
 const P_PROXIMAL: f64 = 1e-8;
+/// Relative objective increase accepted when the clean-up cancels a close pair.
+pub const MERGE_TOLERANCE: f64 = 0.01;
 /// Total rounding allowed per batch (Algorithm 1: below 0.5).
 const ROUNDING_BATCH: f64 = 0.5;
 
@@ -76,6 +78,8 @@ pub struct ComponentSystem<'a> {
     pub rounds: usize,
     /// Iterative-refinement steps over all solves (a conditioning diagnostic).
     pub refinement_steps: usize,
+    /// Upper-triangle triplets of the objective's phi and h blocks.
+    objective_terms: Vec<Triplet>,
 }
 
 /// What went wrong while placing cones.
@@ -217,6 +221,7 @@ impl<'a> ComponentSystem<'a> {
                 a.push((h0 + i, h0 + j, h_weight * basis.gram[i][j]));
             }
         }
+        let objective_terms = a.clone();
         // A tiny proximal term keeps the primal block definite (the matrix is
         // then quasi-definite and LDLᵀ without pivoting is stable); it is a
         // constant once every p is fixed, so final solutions are unaffected.
@@ -302,6 +307,7 @@ impl<'a> ComponentSystem<'a> {
             residual: f64::NAN,
             rounds: 0,
             refinement_steps: 0,
+            objective_terms,
         })
     }
 
@@ -505,6 +511,114 @@ impl<'a> ComponentSystem<'a> {
         }
         self.solve()?;
         Ok(moves)
+    }
+}
+
+impl ComponentSystem<'_> {
+    /// The objective of the last solve: `phiᵀ(alpha L + M/A)phi` plus the
+    /// harmonic term (lexicographic weight, or `alpha hᵀM_1h` for MIQ).
+    pub fn objective(&self) -> f64 {
+        self.objective_terms
+            .iter()
+            .map(|&(r, c, w)| if r == c { w * self.x[r] * self.x[c] } else { 2.0 * w * self.x[r] * self.x[c] })
+            .sum()
+    }
+
+    /// Interior cones as (local vertex, k).
+    fn interior_cones(&self) -> Vec<(usize, i64)> {
+        let k = self.vertex_k();
+        (0..k.len()).filter(|&i| k[i] != 0 && !self.mesh.is_boundary_vertex(self.tree.vertices[i])).map(|i| (i, k[i])).collect()
+    }
+
+    /// Clean-up of section 5.3 (after Myles & Zorin 2012): cancels pairs of
+    /// interior cones of opposite index one or two edges apart, unless that
+    /// raises the objective by more than [`MERGE_TOLERANCE`] (on coarse
+    /// meshes a close pair can carry a real rotation). Returns the pairs removed.
+    pub fn merge_close_pairs(&mut self) -> Result<usize, ConeError> {
+        let mut merged = 0;
+        let mut rejected: std::collections::HashSet<(usize, usize)> = Default::default();
+        let mut current = self.objective();
+        loop {
+            let cones = self.interior_cones();
+            let index: std::collections::HashMap<usize, i64> = cones.iter().copied().collect();
+            let mut pair = None;
+            'search: for &(i, ki) in &cones {
+                let v = self.tree.vertices[i];
+                for w in self.mesh.one_ring(v) {
+                    for x in std::iter::once(w).chain(self.mesh.one_ring(w)) {
+                        let j = self.local[x as usize] as usize;
+                        if j != i && index.get(&j) == Some(&-ki) && !rejected.contains(&(i, j)) {
+                            pair = Some((i, j, ki));
+                            break 'search;
+                        }
+                    }
+                }
+            }
+            let Some((i, j, ki)) = pair else { break };
+            self.transfer(i, j, ki);
+            self.solve()?;
+            let e = self.objective();
+            if e <= current * (1.0 + MERGE_TOLERANCE) {
+                current = e;
+                merged += 1;
+            } else {
+                self.transfer(j, i, ki);
+                rejected.insert((i, j));
+                rejected.insert((j, i));
+            }
+        }
+        self.solve()?;
+        Ok(merged)
+    }
+
+    /// Pair cancellation by descent on the objective (an extension of the
+    /// paper's clean-up to distant pairs): for each interior cone, tries
+    /// cancelling it against each of its `nearest` closest cones of opposite
+    /// index and keeps the best cancellation while the objective decreases.
+    /// Returns the number of pairs removed.
+    pub fn cancel_pairs(&mut self, nearest: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
+        let mut removed = 0;
+        let mut current = self.objective();
+        loop {
+            progress(removed);
+            let cones = self.interior_cones();
+            let (mesh, vertices) = (self.mesh, self.tree.vertices.clone());
+            let pos = |i: usize| mesh.position(vertices[i]);
+            let mut best: Option<(f64, usize, usize, i64)> = None;
+            for &(i, ki) in &cones {
+                let mut partners: Vec<(f64, usize)> = cones
+                    .iter()
+                    .filter(|&&(j, kj)| kj == -ki && j != i)
+                    .map(|&(j, _)| {
+                        let (a, b) = (pos(i), pos(j));
+                        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2), j)
+                    })
+                    .collect();
+                partners.sort_by(|a, b| a.0.total_cmp(&b.0));
+                for &(_, j) in partners.iter().take(nearest) {
+                    if ki < 0 {
+                        continue; // each pair is tried once, from its positive cone
+                    }
+                    self.transfer(i, j, ki);
+                    self.solve()?;
+                    let e = self.objective();
+                    if e < current * (1.0 - 1e-9) && best.map_or(true, |b| e < b.0) {
+                        best = Some((e, i, j, ki));
+                    }
+                    self.transfer(j, i, ki);
+                }
+            }
+            match best {
+                Some((e, i, j, ki)) => {
+                    self.transfer(i, j, ki);
+                    current = e;
+                    removed += 1;
+                }
+                None => break,
+            }
+        }
+        self.solve()?;
+        Ok(removed)
     }
 }
 

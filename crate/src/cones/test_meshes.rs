@@ -98,33 +98,68 @@ pub fn square_annulus(n: usize, rings: usize, inner: f64, angle: f64) -> TriMesh
 }
 
 /// The ring-with-flap shape of the paper's Figure 10: a circular strip ring
-/// (radii 1 to 1.5) with a radial flap (out to radius 2.5, about 0.35 wide)
-/// protruding from its outer side; `n` cells around the ring.
+/// (radii 1 to 1.5, `n` columns around) whose outer side widens smoothly
+/// over the first quarter turn (out to radius 2) and then splits: the outer
+/// half continues as a flap, separated from the ring by a slit, and ends
+/// with two right-angle corners at half a turn. A cone-free aligned map must
+/// give the ring one parametric width everywhere, so the flap collapses.
 pub fn ring_with_flap(n: usize) -> TriMesh {
     use std::collections::HashMap;
     use std::f64::consts::PI;
-    let radii = [1.0, 1.125, 1.25, 1.375, 1.5, 1.75, 2.0, 2.25, 2.5];
-    let ring_rows = 4; // rows 0..4 are the ring, rows 4..8 the flap
-    let flap_cells = 2; // cells on each side of angle 0
-    let mut id: HashMap<(usize, usize), u32> = HashMap::new();
+    assert!(n % 4 == 0);
+    let (quarter, half) = (n / 4, n / 2);
+    let theta = |i: usize| 2.0 * PI * i as f64 / n as f64;
+    let outer = |i: usize| if i <= quarter { 1.5 + 0.5 * theta(i).sin() } else { 2.0 };
+    #[derive(Clone, Copy, PartialEq, Eq, Hash)]
+    enum Key {
+        Ring(usize, usize),
+        Outer(usize, usize), // rows 8..=12 of the widened part and the flap
+    }
+    let mut id: HashMap<Key, u32> = HashMap::new();
     let mut p: Vec<[f64; 3]> = Vec::new();
-    let mut vert = |i: usize, j: usize, p: &mut Vec<[f64; 3]>| {
-        let i = i % n;
-        *id.entry((i, j)).or_insert_with(|| {
-            let a = 2.0 * PI * i as f64 / n as f64;
-            p.push([radii[j] * a.cos(), radii[j] * a.sin(), 0.0]);
+    let mut vert = |key: Key, p: &mut Vec<[f64; 3]>| {
+        *id.entry(key).or_insert_with(|| {
+            let (i, r) = match key {
+                Key::Ring(i, j) => (i, 1.0 + 0.5 * j as f64 / 8.0),
+                Key::Outer(i, j) => (i, 1.5 + (outer(i) - 1.5) * (j - 8) as f64 / 4.0),
+            };
+            let a = theta(i);
+            p.push([r * a.cos(), r * a.sin(), 0.0]);
             (p.len() - 1) as u32
         })
     };
+    // Vertex of the outer part at column i, row j (8..=12): row 8 is the
+    // ring's outer row up to the split, the flap's own row after it.
+    let outer_key = |i: usize, j: usize| {
+        if j == 8 && i <= quarter {
+            Key::Ring(i % n, 8)
+        } else {
+            Key::Outer(i, j)
+        }
+    };
     let mut t = Vec::new();
-    for j in 0..radii.len() - 1 {
-        for i in 0..n {
-            let in_flap = i < flap_cells || i >= n - flap_cells;
-            if j >= ring_rows && !in_flap {
+    for i in 0..n {
+        for j in 0..8 {
+            let a = vert(Key::Ring(i, j), &mut p);
+            let b = vert(Key::Ring((i + 1) % n, j), &mut p);
+            let c = vert(Key::Ring((i + 1) % n, j + 1), &mut p);
+            let d = vert(Key::Ring(i, j + 1), &mut p);
+            t.push([a, b, c]);
+            t.push([a, c, d]);
+        }
+    }
+    for i in 0..half {
+        for j in 8..12 {
+            let b = vert(outer_key(i + 1, j), &mut p);
+            let c = vert(outer_key(i + 1, j + 1), &mut p);
+            if i == 0 {
+                // The widening starts from the single ring vertex at angle 0.
+                let a = vert(Key::Ring(0, 8), &mut p);
+                t.push([a, b, c]);
                 continue;
             }
-            let (a, b) = (vert(i, j, &mut p), vert(i + 1, j, &mut p));
-            let (c, d) = (vert(i + 1, j + 1, &mut p), vert(i, j + 1, &mut p));
+            let a = vert(outer_key(i, j), &mut p);
+            let d = vert(outer_key(i, j + 1), &mut p);
             t.push([a, b, c]);
             t.push([a, c, d]);
         }

@@ -38,15 +38,15 @@ fn octahedron_gets_eight_quarter_turns() {
 }
 
 #[test]
-fn torus_has_two_homology_loops_and_balanced_cones() {
+fn torus_of_revolution_has_two_loops_and_balanced_cones() {
     let mesh = torus(24, 12, 2.0, 0.7);
     let r = run(&mesh, 100.0, false);
     assert_gauss_bonnet(&mesh, &r);
     assert_eq!(r.components[0].path_integers.len(), 2, "two homology loops");
     assert_eq!(r.cones.iter().map(|c| c.k).sum::<i32>(), 0);
-    // Known shortfall (see the issue note): the greedy rounding leaves cone
-    // pairs on the torus of revolution at alpha = 100 although a cone-free
-    // solution has lower energy.
+    // Known shortfall (reported on the issue): at alpha = 100 the greedy
+    // rounding still leaves cone pairs on the outer and inner equators,
+    // although the cone-free solution has a lower objective.
 }
 
 #[test]
@@ -72,7 +72,7 @@ fn rotated_annulus_absorbs_the_rotation_with_cones() {
 #[test]
 fn ring_with_flap_gets_cones_where_miq_emulation_gets_none() {
     // Figure 10: boundary alignment forces a cone-free map to collapse the flap.
-    let mesh = super::test_meshes::ring_with_flap(72);
+    let mesh = super::test_meshes::ring_with_flap(96);
     assert_eq!(mesh.boundary_loops().len(), 2);
     let ours = run(&mesh, DEFAULT_ALPHA, false);
     assert_gauss_bonnet(&mesh, &ours);
