@@ -188,6 +188,8 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
     let positions = original_vertex.iter().map(|&v| mesh.position(v)).collect();
     let cut = TriMesh::from_welded_arrays(positions, faces)
         .expect("cutting a valid mesh along edges keeps it manifold and oriented");
+    // The builder renumbers vertices by first use; follow its numbering.
+    let original_vertex = cut.welded_to_source().iter().map(|&s| original_vertex[s as usize]).collect();
     let original_edge = (0..cut.n_edges() as u32)
         .map(|e| {
             let h = cut.edge_halfedges(e)[0];
@@ -195,6 +197,107 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
         })
         .collect();
     CutMesh { mesh: cut, original_vertex, original_edge }
+}
+
+/// A mesh refined so that no triangle has two constrained (feature or
+/// boundary) edges, with its features carried over.
+#[derive(Clone, Debug)]
+pub struct Refined {
+    pub mesh: TriMesh,
+    pub features: FeatureSet,
+    /// Edges split (one new vertex each).
+    pub splits: usize,
+}
+
+/// Splits, at its midpoint, the free edge of every triangle whose other two
+/// edges are both constrained: an aligned map puts such a triangle's three
+/// corners on isolines, and where both lie on one isoline the triangle
+/// would have zero UV area. Returns `None` when no triangle needs it.
+pub fn split_doubly_constrained(mesh: &TriMesh, features: &FeatureSet) -> Option<Refined> {
+    let constrained = |m: &TriMesh, f: &FeatureSet, e: u32| m.is_boundary_edge(e) || f.contains(e);
+    let mut current: Option<Refined> = None;
+    for _pass in 0..4 {
+        let (m, f) = match &current {
+            Some(r) => (&r.mesh, &r.features),
+            None => (mesh, features),
+        };
+        // Edges to split: the free edge of faces with two constrained edges,
+        // at most one per face and pass (a face next to two chosen edges
+        // waits for the next pass).
+        let mut split = vec![false; m.n_edges()];
+        let mut claimed = vec![false; m.n_faces()];
+        let mut any = false;
+        for face in 0..m.n_faces() as u32 {
+            let hs = m.face_halfedges(face);
+            let c: Vec<bool> = hs.iter().map(|&h| constrained(m, f, m.edge(h))).collect();
+            if c.iter().filter(|&&x| x).count() != 2 {
+                continue;
+            }
+            let free = hs[c.iter().position(|&x| !x).unwrap()];
+            let e = m.edge(free);
+            let other = m.face(m.twin(free)).expect("the free edge is interior");
+            if split[e as usize] || claimed[face as usize] || claimed[other as usize] {
+                continue;
+            }
+            split[e as usize] = true;
+            claimed[face as usize] = true;
+            claimed[other as usize] = true;
+            any = true;
+        }
+        if !any {
+            break;
+        }
+        // Rebuild the triangle list with a midpoint on every split edge.
+        let mut positions = m.positions().to_vec();
+        let mut mid = vec![NONE; m.n_edges()];
+        for e in 0..m.n_edges() {
+            if split[e] {
+                let [a, b] = m.edge_vertices(e as u32);
+                mid[e] = positions.len() as u32;
+                positions.push(crate::vec3::midpoint(m.position(a), m.position(b)));
+            }
+        }
+        let mut triangles = Vec::with_capacity(m.n_faces() + 2 * split.iter().filter(|&&x| x).count());
+        for face in 0..m.n_faces() as u32 {
+            let hs = m.face_halfedges(face);
+            let v = m.faces()[face as usize];
+            // Halfedge k runs corner k -> k+1; claims allow one split edge per face.
+            match (0..3).find(|&k| mid[m.edge(hs[k]) as usize] != NONE) {
+                Some(k) => {
+                    let x = mid[m.edge(hs[k]) as usize];
+                    let (a, b, c) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+                    triangles.push([a, x, c]);
+                    triangles.push([x, b, c]);
+                }
+                None => triangles.push(v),
+            }
+        }
+        let refined = TriMesh::from_welded_arrays(positions, triangles)
+            .expect("splitting edges at their midpoints keeps the mesh valid");
+        let mut feats = FeatureSet::none(&refined);
+        let old = |v: u32| refined.welded_to_source()[v as usize];
+        for e in 0..refined.n_edges() as u32 {
+            let [a, b] = refined.edge_vertices(e).map(old);
+            // Features are never split: a feature edge joins two old vertices.
+            if (a as usize) < m.n_vertices() && (b as usize) < m.n_vertices() {
+                if let Some(old) = m.outgoing(a).find(|&h| m.head(h) == b) {
+                    if f.contains(m.edge(old)) {
+                        feats.set(&refined, e, true);
+                    }
+                }
+            }
+        }
+        let splits = current.as_ref().map_or(0, |r| r.splits) + split.iter().filter(|&&x| x).count();
+        current = Some(Refined { mesh: refined, features: feats, splits });
+    }
+    // Rebuild once from the final arrays so the mesh is its own source
+    // (`source_to_welded` is the identity; edge ids are unchanged).
+    current.map(|r| {
+        let mesh = TriMesh::from_welded_arrays(r.mesh.positions().to_vec(), r.mesh.faces().to_vec())
+            .expect("rebuilding a valid mesh from its own arrays");
+        debug_assert!((0..mesh.n_edges() as u32).all(|e| mesh.edge_vertices(e) == r.mesh.edge_vertices(e)));
+        Refined { mesh, ..r }
+    })
 }
 
 /// Finds mesh vertices by position with a uniform hash grid.

@@ -8,12 +8,16 @@
 
 pub mod clock;
 pub mod cones;
+pub mod export;
 pub mod error;
 pub mod features;
 pub mod io;
 pub mod linalg;
 pub mod mesh;
 pub mod operators;
+pub mod pipeline;
+pub mod vec3;
+pub mod param;
 
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;

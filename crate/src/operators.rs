@@ -18,24 +18,7 @@ use std::f64::consts::PI;
 
 use sprs::{CsMat, TriMat};
 
-type V3 = [f64; 3];
-
-#[inline]
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-#[inline]
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
+use crate::vec3::{cross, dot, norm, sub, V3};
 
 #[inline]
 fn corners(positions: &[V3], t: &[u32; 3]) -> [V3; 3] {

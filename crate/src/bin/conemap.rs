@@ -30,6 +30,20 @@ commands:
                        by end positions. --no-moves: skip the cone-location
                        optimization. --json prints one JSON object.
 
+  solve FILE -o OUT [--alpha A] [--miq] [--sharp DEG] [--features FEATURES.json]
+             [--no-moves] [--report REPORT.json] [--checker]
+                       place cones, compute the seamless parametrization and
+                       write the mesh with UVs to OUT: .glb, .gltf (buffer
+                       embedded) or .obj, by extension. Vertices are split
+                       exactly along the UV seams. UVs are normalised into
+                       [0,1] preserving aspect; glTF stores (u, 1-v), OBJ
+                       (u, v). A glTF input keeps its primitives, materials
+                       (factors) and normals. Cone options as for cones.
+                       --report: write a JSON report (the cones --json
+                       fields plus metrics and per-stage timings).
+                       --checker: embed a checkerboard texture (glTF),
+                       squares of 2^-k UV units (at least 16 across).
+
 options:
   -h, --help           print this help
 
@@ -40,6 +54,10 @@ problems), 1 when the input could not be read, parsed or used, 2 for bad usage."
 const COMMANDS: &[(&str, &[&str])] = &[
     ("info", &["--json"]),
     ("cones", &["--json", "--miq", "--no-moves", "--alpha=", "--sharp=", "--features="]),
+    (
+        "solve",
+        &["--miq", "--no-moves", "--checker", "--alpha=", "--sharp=", "--features=", "--report=", "-o=", "--output="],
+    ),
 ];
 
 /// A failure: the one-line message and the exit status.
@@ -77,6 +95,7 @@ fn run(args: &[String]) -> Result<(), Failure> {
             match name {
                 "info" => info(&parsed),
                 "cones" => cones_command(&parsed),
+                "solve" => solve(&parsed),
                 _ => unreachable!("command listed in COMMANDS without a handler"),
             }
         }
@@ -306,4 +325,145 @@ fn print_cones(file: &str, mesh: &TriMesh, features: &FeatureSet, options: &Cone
         "  time: cut {:.3} s, topology {:.3} s, rounding {:.3} s, cone moves {:.3} s, total {:.3} s",
         t.cut, t.topology, t.rounding, t.cone_moves, t.total
     );
+}
+
+/// `solve`: import, cones, parametrization, export.
+fn solve(args: &Args) -> Result<(), Failure> {
+    use conemap::export::{self, ExportInput, ExportOptions, Format};
+    use conemap::io::{self, InputFile};
+    use conemap::mesh::RawMesh;
+    use conemap::param::ParamOptions;
+    use conemap::pipeline::{self, SolveOptions};
+
+    let file = args.file()?;
+    let out = args.value("-o").or_else(|| args.value("--output")).ok_or_else(|| usage("solve needs -o OUT"))?;
+    let Some(format) = Format::from_path(out) else {
+        return Err(usage(&format!("{out}: unknown output format (use .glb, .gltf or .obj)")));
+    };
+    let options = cone_options(args)?;
+    // Fail before the long computation when the output cannot be created.
+    for path in [Some(out), args.value("--report")].into_iter().flatten() {
+        let parent = Path::new(path).parent().filter(|p| !p.as_os_str().is_empty());
+        if let Some(dir) = parent {
+            if !dir.is_dir() {
+                return Err(Failure(format!("{path}: cannot write: directory {} does not exist", dir.display()), 1));
+            }
+        }
+        if Path::new(path).is_dir() {
+            return Err(Failure(format!("{path}: cannot write: is a directory"), 1));
+        }
+    }
+
+    let mut clock = conemap::clock::Stopwatch::start();
+    let bytes = std::fs::read(file).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let name = Path::new(file).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let main = InputFile { name, bytes };
+    let others = io::gltf::sibling_buffers(Path::new(file), &main).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let lower = main.name.to_ascii_lowercase();
+    let is_gltf = main.bytes.starts_with(b"glTF") || lower.ends_with(".glb") || lower.ends_with(".gltf");
+    let (raw, source) = if is_gltf {
+        let (raw, source) = io::gltf::import_with_source(&main, &others).map_err(|e| Failure(e.to_string(), 1))?;
+        (raw, Some(source))
+    } else {
+        (io::import(&main, &others).map_err(|e| Failure(e.to_string(), 1))?, None)
+    };
+    let mesh = TriMesh::from_raw(&raw).map_err(|problems| {
+        let first = problems.first().map(|p| p.to_string()).unwrap_or_default();
+        let more = if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
+        Failure(format!("{file}: cannot be parametrized: {first}{more}"), 1)
+    })?;
+    let t_import = clock.lap();
+
+    let features = load_features(args, &mesh)?;
+    let solve_options = SolveOptions { cones: options, param: ParamOptions::default() };
+    let solution = pipeline::solve(&mesh, &features, &solve_options, &mut |_| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let (placement, result) = (&solution.placement, &solution.param);
+    let t_cones = solution.refine_seconds + placement.timings.total;
+    let t_param = clock.lap() - t_cones;
+
+    // Splitting doubly constrained triangles adds vertices: export the refined
+    // mesh then (its source attributes are not carried over).
+    let refined_raw;
+    let (raw_used, source_used) = if solution.splits > 0 {
+        refined_raw = RawMesh { positions: solution.mesh.positions().to_vec(), triangles: solution.mesh.faces().to_vec() };
+        (&refined_raw, None)
+    } else {
+        (&raw, source.as_ref())
+    };
+    let mesh = &*solution.mesh;
+    let features = &*solution.features;
+    let mut input = ExportInput::new(raw_used, mesh, &result.uv).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    if let Some(source) = source_used {
+        input = input.with_gltf_source(source, &main, &others);
+    }
+    let stem = Path::new(file).file_stem().map(|s| s.to_string_lossy().into_owned());
+    let export_options = ExportOptions { checker: args.flag("--checker"), name: stem, ..ExportOptions::default() };
+    let data = export::export(&input, format, &export_options);
+    std::fs::write(out, &data).map_err(|e| Failure(format!("{out}: cannot write: {e}"), 1))?;
+    let t_export = clock.lap();
+    let total = t_import + t_cones + t_param + t_export;
+
+    if let Some(path) = args.value("--report") {
+        let mut report = cones_json(mesh, features, &options, placement);
+        report["split_edges"] = serde_json::json!(solution.splits);
+        report["metrics"] = serde_json::json!(result.metrics);
+        report["seam_edges"] = serde_json::json!(result.seam_edges.len());
+        report["arap_iterations"] = serde_json::json!(result.arap_iterations);
+        report["flips_before_repair"] = serde_json::json!(result.flips_before_repair);
+        report["flips_fixed"] = serde_json::json!(result.flips_fixed);
+        report["output"] = serde_json::json!({
+            "path": out,
+            "format": format!("{format:?}").to_ascii_lowercase(),
+            "vertices": input.output_vertex_count(),
+            "faces": mesh.n_faces(),
+            "bytes": data.len(),
+            "uv_normalization": {"offset": input.uv_normalization().offset, "scale": input.uv_normalization().scale},
+            "notes": input.notes(),
+        });
+        report["timings"] = serde_json::json!({
+            "import": t_import,
+            "cones": placement.timings,
+            "refine": solution.refine_seconds,
+            "cones_total": t_cones,
+            "param": result.timings,
+            "param_total": t_param,
+            "export": t_export,
+            "total": total,
+        });
+        let text = serde_json::to_string_pretty(&report).map_err(|e| Failure(e.to_string(), 1))?;
+        std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
+    }
+
+    let m = &result.metrics;
+    println!("{file}: {} vertices, {} faces, {} feature edges", mesh.n_vertices(), mesh.n_faces(), features.len());
+    println!(
+        "  cones: {} ({} positive, {} negative), {} boundary corners",
+        placement.cones.len(),
+        placement.cones.iter().filter(|c| c.k > 0).count(),
+        placement.cones.iter().filter(|c| c.k < 0).count(),
+        placement.boundary_corners.len()
+    );
+    println!(
+        "  distortion {:.4} (max {:.4}), flipped triangles {} ({} fixed by repair), {} seam edges",
+        m.distortion,
+        m.max_distortion,
+        m.flipped,
+        result.flips_fixed,
+        result.seam_edges.len()
+    );
+    if solution.splits > 0 {
+        println!("  note: split {} edges so no triangle has two constrained edges", solution.splits);
+    }
+    for note in input.notes() {
+        println!("  note: {note}");
+    }
+    println!(
+        "  wrote {out}: {} vertices, {} faces",
+        input.output_vertex_count(),
+        mesh.n_faces()
+    );
+    println!(
+        "  time: import {t_import:.3} s, cones {t_cones:.3} s, parametrization {t_param:.3} s, export {t_export:.3} s, total {total:.3} s"
+    );
+    Ok(())
 }

@@ -9,6 +9,7 @@
 //! next.h_in`) or passes through the outer node through two boundary edges.
 
 use crate::mesh::TriMesh;
+use crate::vec3::{self, cross, dot, norm, scale, sub};
 use std::f64::consts::PI;
 
 /// One face of a dual path: enters through the edge of face halfedge `h_in`,
@@ -156,30 +157,7 @@ pub fn vertex_cycle(mesh: &TriMesh, v: u32) -> Vec<Visit> {
 }
 
 fn midpoint(mesh: &TriMesh, h: u32) -> [f64; 3] {
-    let a = mesh.position(mesh.tail(h));
-    let b = mesh.position(mesh.head(h));
-    [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])]
-}
-
-#[inline]
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-#[inline]
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-#[inline]
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
+    vec3::midpoint(mesh.position(mesh.tail(h)), mesh.position(mesh.head(h)))
 }
 
 #[cfg(test)]

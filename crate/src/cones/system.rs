@@ -19,6 +19,7 @@ use super::frames::{vertex_cycle, Frames, Visit};
 use super::harmonic::HarmonicBasis;
 use crate::linalg::{Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
 use crate::mesh::{TriMesh, NONE};
+use crate::vec3;
 use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::PI;
 
@@ -654,8 +655,8 @@ fn face_cotangents(mesh: &TriMesh, f: u32) -> [f64; 3] {
     let tri = mesh.faces()[f as usize];
     let p = tri.map(|v| mesh.position(v));
     [0, 1, 2].map(|k| {
-        let u = super::frames::sub(p[(k + 1) % 3], p[k]);
-        let w = super::frames::sub(p[(k + 2) % 3], p[k]);
-        super::frames::dot(u, w) / super::frames::norm(super::frames::cross(u, w))
+        let u = vec3::sub(p[(k + 1) % 3], p[k]);
+        let w = vec3::sub(p[(k + 2) % 3], p[k]);
+        vec3::dot(u, w) / vec3::norm(vec3::cross(u, w))
     })
 }

@@ -1,0 +1,175 @@
+//! Quality figures of a parametrization: the isometric distortion of eq. (19)
+//! at the best global scale, flips, seamlessness and alignment residuals.
+
+use super::cut_graph::CutGraph;
+use super::local_triangle;
+use super::seamless::signed_uv_area;
+use crate::cones::ConePlacement;
+use crate::mesh::TriMesh;
+use serde::Serialize;
+use std::f64::consts::FRAC_PI_2;
+
+/// Figures of one parametrization.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Metrics {
+    /// eq. (19): `(1/A) sum_f A_f min_R |s J_f - R|_F` at the best scale `s`.
+    pub distortion: f64,
+    /// The global UV scale `s` at which `distortion` is measured.
+    pub scale: f64,
+    /// Fraction of triangles (by count) with distortion below 0.2 / 0.3.
+    pub fraction_below_0_2: f64,
+    pub fraction_below_0_3: f64,
+    /// Largest per-triangle distortion.
+    pub max_distortion: f64,
+    /// Triangles with signed UV area ≤ 0.
+    pub flipped: usize,
+    /// Largest deviation (radians) of a seam edge's transition from a multiple of 90°.
+    pub seam_angle_residual: f64,
+    /// Largest relative difference of the two UV lengths of a seam edge.
+    pub seam_length_residual: f64,
+    /// Largest angle (radians) between a feature/boundary edge's UV image and the nearest axis.
+    pub alignment_residual: f64,
+    /// Interior cones and boundary corners of the input mesh.
+    pub cones: usize,
+    pub boundary_corners: usize,
+    pub seam_edges: usize,
+    /// Total 3D length of the seam edges.
+    pub seam_length: f64,
+    pub faces: usize,
+}
+
+/// Per-triangle `min_R |s J - R|_F` from the conformal / anticonformal norms of `J`.
+fn tri_distortion(conf: f64, anti: f64, s: f64) -> f64 {
+    (2.0 * s * s * (conf * conf + anti * anti) - 4.0 * s * conf + 2.0).max(0.0).sqrt()
+}
+
+/// Jacobian (UV per unit length, in the face frame) and area of every face.
+pub fn face_jacobians(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<([[f64; 2]; 2], f64)> {
+    (0..mesh.n_faces() as u32)
+        .map(|f| {
+            let (q, area) = local_triangle(mesh, f);
+            let mut j = [[0.0; 2]; 2];
+            for k in 0..3 {
+                let (a, b) = (q[(k + 1) % 3], q[(k + 2) % 3]);
+                let g = [-(b[1] - a[1]) / (2.0 * area), (b[0] - a[0]) / (2.0 * area)];
+                let p = uv[3 * f as usize + k];
+                for c in 0..2 {
+                    j[c][0] += p[c] * g[0];
+                    j[c][1] += p[c] * g[1];
+                }
+            }
+            (j, area)
+        })
+        .collect()
+}
+
+/// Sum of the UV corner angles around every vertex of `mesh` (all wedges):
+/// `2 pi - k pi/2` at an interior vertex of cone index `k` for a seamless,
+/// fold-free map.
+pub fn uv_angle_sums(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<f64> {
+    let mut sums = vec![0.0; mesh.n_vertices()];
+    for (f, t) in mesh.faces().iter().enumerate() {
+        for k in 0..3 {
+            let p = uv[3 * f + k];
+            let a = uv[3 * f + (k + 1) % 3];
+            let b = uv[3 * f + (k + 2) % 3];
+            let (u, v) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
+            sums[t[k] as usize] += (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1]).abs();
+        }
+    }
+    sums
+}
+
+fn axis_deviation(angle: f64) -> f64 {
+    (angle - (angle / FRAC_PI_2).round() * FRAC_PI_2).abs()
+}
+
+/// Computes every figure of [`Metrics`] for per-corner `uv` (index `3 f + k`).
+pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[[f64; 2]]) -> Metrics {
+    let nf = mesh.n_faces();
+    let jac = face_jacobians(mesh, uv);
+    let parts: Vec<(f64, f64, f64)> = jac
+        .iter()
+        .map(|&(j, area)| {
+            let (a, b, c, d) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+            let conf = (0.25 * ((a + d).powi(2) + (b - c).powi(2))).sqrt();
+            let anti = (0.25 * ((a - d).powi(2) + (b + c).powi(2))).sqrt();
+            (conf, anti, area)
+        })
+        .filter(|p| p.0.is_finite() && p.1.is_finite())
+        .collect();
+    let total: f64 = parts.iter().map(|p| p.2).sum::<f64>().max(f64::MIN_POSITIVE);
+    let mean = |s: f64| parts.iter().map(|&(c, a, w)| w * tri_distortion(c, a, s)).sum::<f64>() / total;
+    // Least-squares scale as a centre, then golden-section search on log s (the mean is convex in s).
+    let num: f64 = parts.iter().map(|&(c, _, w)| w * c).sum();
+    let den: f64 = parts.iter().map(|&(c, a, w)| w * (c * c + a * a)).sum();
+    let s0 = if den > 0.0 && num > 0.0 { num / den } else { 1.0 };
+    let (mut lo, mut hi) = ((s0 / 8.0).ln(), (s0 * 8.0).ln());
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (mean(x1.exp()), mean(x2.exp()));
+    for _ in 0..80 {
+        if f1 < f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - g * (hi - lo);
+            f1 = mean(x1.exp());
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + g * (hi - lo);
+            f2 = mean(x2.exp());
+        }
+    }
+    let scale = (0.5 * (lo + hi)).exp();
+    let per_tri: Vec<f64> = parts.iter().map(|&(c, a, _)| tri_distortion(c, a, scale)).collect();
+    let n = per_tri.len().max(1) as f64;
+
+    let flipped = (0..nf).filter(|&f| !(signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]) > 0.0)).count();
+
+    let (mut seam_angle, mut seam_len, mut seam_length) = (0.0f64, 0.0f64, 0.0);
+    for &e in &cut.seam_edges {
+        let [h, t] = mesh.edge_halfedges(e);
+        let (Some(_), Some(_)) = (mesh.face(h), mesh.face(t)) else { continue };
+        let d = |a: u32, b: u32| {
+            let (p, q) = (uv[a as usize], uv[b as usize]);
+            [q[0] - p[0], q[1] - p[1]]
+        };
+        let ef = d(h, mesh.next(h));
+        let eg = d(mesh.next(t), t);
+        let ang = (ef[0] * eg[1] - ef[1] * eg[0]).atan2(ef[0] * eg[0] + ef[1] * eg[1]);
+        seam_angle = seam_angle.max(axis_deviation(ang));
+        let (lf, lg) = (ef[0].hypot(ef[1]), eg[0].hypot(eg[1]));
+        seam_len = seam_len.max((lf - lg).abs() / lf.max(lg).max(f64::MIN_POSITIVE));
+        let p = mesh.edge_vertices(e).map(|v| mesh.position(v));
+        seam_length += ((p[0][0] - p[1][0]).powi(2) + (p[0][1] - p[1][1]).powi(2) + (p[0][2] - p[1][2]).powi(2)).sqrt();
+    }
+
+    let cm = &placement.cut.mesh;
+    let mut alignment = 0.0f64;
+    for h in 0..3 * nf as u32 {
+        if cm.is_boundary_halfedge(cm.twin(h)) {
+            let (p, q) = (uv[h as usize], uv[mesh.next(h) as usize]);
+            let ang = (q[1] - p[1]).atan2(q[0] - p[0]);
+            alignment = alignment.max(axis_deviation(ang));
+        }
+    }
+    Metrics {
+        distortion: mean(scale),
+        scale,
+        fraction_below_0_2: per_tri.iter().filter(|&&d| d < 0.2).count() as f64 / n,
+        fraction_below_0_3: per_tri.iter().filter(|&&d| d < 0.3).count() as f64 / n,
+        max_distortion: per_tri.iter().cloned().fold(0.0, f64::max),
+        flipped,
+        seam_angle_residual: seam_angle,
+        seam_length_residual: seam_len,
+        alignment_residual: alignment,
+        cones: placement.cones.len(),
+        boundary_corners: placement.boundary_corners.len(),
+        seam_edges: cut.seam_edges.len(),
+        seam_length,
+        faces: nf,
+    }
+}

@@ -1,0 +1,247 @@
+//! Parametrization from the connection (paper Appendix B): the cross-field
+//! of B.1 ([`field`]), a cut to a topological disk through every cone
+//! ([`cut_graph`], B step 1), the seamless Poisson solve of eq. (23) followed
+//! by ARAP local/global iterations and a fold-over repair ([`seamless`]),
+//! and the quality figures of section 7 ([`metrics`], eq. 19).
+//!
+//! Input: the original [`TriMesh`] and the [`ConePlacement`] computed on it.
+//! Output: one UV per face corner (`3 f + k`), seamless across every seam
+//! edge (transition `f(p2) = Rot(m pi/2) f(p1) + t`) and with every feature
+//! and boundary edge on an isoline.
+
+pub mod cut_graph;
+pub mod field;
+pub mod metrics;
+pub mod seamless;
+#[cfg(test)]
+mod tests;
+
+use crate::clock::Stopwatch;
+use crate::cones::ConePlacement;
+use crate::linalg::SolveError;
+use crate::mesh::TriMesh;
+use serde::Serialize;
+use std::fmt;
+
+pub use cut_graph::CutGraph;
+pub use field::CrossField;
+pub use metrics::Metrics;
+
+/// Settings of the parametrization stage.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamOptions {
+    /// Cap on ARAP local/global iterations (0: Poisson solution only).
+    pub max_arap_iterations: usize,
+    /// ARAP stops once the relative energy decrease falls below this.
+    pub arap_tolerance: f64,
+    /// Keep the target rotation of triangles adjacent to features and
+    /// boundaries fixed to the field (Appendix B.2, local step).
+    pub fix_feature_rotations: bool,
+    /// Rounds of the fold-over repair (local reweighting); 0 disables it.
+    pub repair_rounds: usize,
+}
+
+impl Default for ParamOptions {
+    fn default() -> Self {
+        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 4 }
+    }
+}
+
+/// Progress reports, in order.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum ParamProgress {
+    Field,
+    Cut,
+    Poisson,
+    /// ARAP iteration `iteration` (1-based) of at most `max`.
+    Arap { iteration: usize, max: usize },
+    /// Fold-over repair round `round`, `flips` flipped triangles before it.
+    Repair { round: usize, flips: usize },
+}
+
+/// Seconds per stage.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ParamTimings {
+    pub cut: f64,
+    pub field: f64,
+    pub poisson: f64,
+    pub arap: f64,
+    pub repair: f64,
+    pub metrics: f64,
+}
+
+/// The result of [`parametrize`].
+#[derive(Clone, Debug, Serialize)]
+pub struct Parametrization {
+    /// UV per face corner, index `3 f + k` (corner `k` of face `f`).
+    pub uv: Vec<[f64; 2]>,
+    /// Seam edges (ids of the original mesh): the cut graph's interior edges
+    /// and every opened feature edge.
+    pub seam_edges: Vec<u32>,
+    pub metrics: Metrics,
+    /// ARAP iterations run (after the Poisson solve).
+    pub arap_iterations: usize,
+    /// Flipped or degenerate triangles right after ARAP (before repair).
+    pub flips_before_repair: usize,
+    /// Flipped triangles the repair removed.
+    pub flips_fixed: usize,
+    pub timings: ParamTimings,
+}
+
+/// Why the parametrization failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamError {
+    /// The placement does not belong to this mesh.
+    MeshMismatch { what: &'static str, expected: usize, found: usize },
+    /// The mesh has no faces.
+    EmptyMesh,
+    /// A matching `m_e` of eq. (21) is not an integer (the connection is not
+    /// a cross-field connection): `value` quarter turns across original edge `edge`.
+    NonIntegerMatching { edge: u32, value: f64 },
+    /// The field is not aligned with boundary/feature edge `edge` of the cut
+    /// mesh: `value` quarter turns off.
+    Misaligned { edge: u32, value: f64 },
+    /// An edge outside the cut has a non-identity matching (bug guard).
+    UncutSingularity { edge: u32, matching: i64 },
+    /// The solve left a constraint row violated by `residual` (relative to the UV extent).
+    ConstraintViolation { residual: f64 },
+    /// A value became NaN or infinite.
+    NotFinite { what: &'static str },
+    /// The sparse KKT solve failed.
+    Solve(SolveError),
+}
+
+impl fmt::Display for ParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ParamError::MeshMismatch { what, expected, found } => {
+                write!(f, "cone placement does not match the mesh: {what} expected {expected}, found {found}")
+            }
+            ParamError::EmptyMesh => write!(f, "the mesh has no faces"),
+            ParamError::NonIntegerMatching { edge, value } => {
+                write!(f, "cross-field matching across edge {edge} is {value} quarter turns, not an integer")
+            }
+            ParamError::Misaligned { edge, value } => {
+                write!(f, "cross-field is not aligned with boundary edge {edge} ({value} quarter turns)")
+            }
+            ParamError::UncutSingularity { edge, matching } => {
+                write!(f, "edge {edge} is not cut but has matching {matching} (not a multiple of 4)")
+            }
+            ParamError::ConstraintViolation { residual } => {
+                write!(f, "seam/isoline constraints violated after the solve (relative residual {residual:.2e})")
+            }
+            ParamError::NotFinite { what } => write!(f, "{what} is not finite"),
+            ParamError::Solve(e) => write!(f, "parametrization solve failed: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for ParamError {}
+
+impl From<SolveError> for ParamError {
+    fn from(e: SolveError) -> Self {
+        ParamError::Solve(e)
+    }
+}
+
+/// Computes a seamless, feature-aligned parametrization of `mesh` from the
+/// cone placement `placement` (computed on the same `mesh`).
+///
+/// Contract: `placement.cut` must be the cut of `mesh` (same faces), else
+/// [`ParamError::MeshMismatch`]. On success every seam edge's two UV images
+/// differ by a rotation of `k·90°` and a translation, every feature and
+/// boundary edge maps to an axis-parallel segment (both up to solver
+/// round-off), and the metrics describe the result; `progress` is called
+/// at each stage. Never panics on valid inputs; numeric failures are errors.
+pub fn parametrize(
+    mesh: &TriMesh,
+    placement: &ConePlacement,
+    options: &ParamOptions,
+    progress: &mut dyn FnMut(ParamProgress),
+) -> Result<Parametrization, ParamError> {
+    let mut clock = Stopwatch::start();
+    let mut timings = ParamTimings::default();
+    check_inputs(mesh, placement)?;
+
+    progress(ParamProgress::Field);
+    let field = field::cross_field(mesh, placement)?;
+    timings.field = clock.lap();
+
+    progress(ParamProgress::Cut);
+    let cut = cut_graph::cut_graph(mesh, placement, &field)?;
+    timings.cut = clock.lap();
+
+    let result = seamless::solve(mesh, placement, &field, &cut, options, progress, &mut clock, &mut timings)?;
+    let uv: Vec<[f64; 2]> = (0..3 * mesh.n_faces()).map(|c| result.uv[cut.wedge[c] as usize]).collect();
+    if uv.iter().any(|p| !p[0].is_finite() || !p[1].is_finite()) {
+        return Err(ParamError::NotFinite { what: "uv" });
+    }
+    let metrics = metrics::compute(mesh, placement, &cut, &uv);
+    timings.metrics = clock.lap();
+    Ok(Parametrization {
+        uv,
+        seam_edges: cut.seam_edges.clone(),
+        metrics,
+        arap_iterations: result.arap_iterations,
+        flips_before_repair: result.flips_before_repair,
+        flips_fixed: result.flips_fixed,
+        timings,
+    })
+}
+
+fn check_inputs(mesh: &TriMesh, placement: &ConePlacement) -> Result<(), ParamError> {
+    let nf = mesh.n_faces();
+    if nf == 0 {
+        return Err(ParamError::EmptyMesh);
+    }
+    let cm = &placement.cut.mesh;
+    let checks = [
+        ("cut mesh faces", nf, cm.n_faces()),
+        ("omega length", 3 * nf, placement.omega.len()),
+        ("k length", cm.n_vertices(), placement.k.len()),
+        ("original_vertex length", cm.n_vertices(), placement.cut.original_vertex.len()),
+        ("original_edge length", cm.n_edges(), placement.cut.original_edge.len()),
+    ];
+    for (what, expected, found) in checks {
+        if expected != found {
+            return Err(ParamError::MeshMismatch { what, expected, found });
+        }
+    }
+    if placement.cut.original_vertex.iter().any(|&v| v as usize >= mesh.n_vertices())
+        || placement.cut.original_edge.iter().any(|&e| e as usize >= mesh.n_edges())
+    {
+        return Err(ParamError::MeshMismatch { what: "cut-to-original index", expected: mesh.n_vertices(), found: usize::MAX });
+    }
+    for f in 0..nf {
+        let a = mesh.faces()[f];
+        let b = cm.faces()[f];
+        for k in 0..3 {
+            if placement.cut.original_vertex[b[k] as usize] != a[k] {
+                return Err(ParamError::MeshMismatch { what: "face corner", expected: a[k] as usize, found: b[k] as usize });
+            }
+        }
+    }
+    if placement.omega.iter().any(|w| !w.is_finite()) {
+        return Err(ParamError::NotFinite { what: "omega" });
+    }
+    Ok(())
+}
+
+/// Local 2D coordinates of the corners of face `f` in its frame (x along the
+/// first edge, y = n × x, as `cones::frames::Frames`), corner 0 at the origin,
+/// and the face area.
+pub(crate) fn local_triangle(mesh: &TriMesh, f: u32) -> ([[f64; 2]; 3], f64) {
+    let t = mesh.faces()[f as usize];
+    let p = t.map(|v| mesh.position(v));
+    let e0 = sub(p[1], p[0]);
+    let e2 = sub(p[2], p[0]);
+    let l0 = dot(e0, e0).sqrt();
+    let x = [e0[0] / l0, e0[1] / l0, e0[2] / l0];
+    let n = cross(e0, e2);
+    let nn = dot(n, n).sqrt();
+    let nu = [n[0] / nn, n[1] / nn, n[2] / nn];
+    let y = cross(nu, x);
+    ([[0.0, 0.0], [l0, 0.0], [dot(e2, x), dot(e2, y)]], 0.5 * nn)
+}
+
+pub(crate) use crate::vec3::{cross, dot, sub};

@@ -1,0 +1,456 @@
+//! Seamless parametrization (Appendix B.2): linear elements with (u, v) per
+//! wedge of the cut disk; the Poisson problem (23) `min sum_f A_f |grad f - R_f|^2`
+//! under the seam, isoline and pin constraints, enforced exactly through one
+//! KKT system; ARAP local/global iterations (eq. 4, Liu et al. 2008) that
+//! reuse its factorization; then a fold-over repair by local reweighting.
+
+use super::cut_graph::CutGraph;
+use super::field::{CrossField, NO_ISOLINE};
+use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
+use crate::clock::Stopwatch;
+use crate::cones::ConePlacement;
+use crate::linalg::{Kkt, LdltSolver, SolverOptions, Triplet};
+use crate::mesh::TriMesh;
+
+/// Result of [`solve`]: UV per wedge.
+#[derive(Clone, Debug)]
+pub struct SeamlessResult {
+    pub uv: Vec<[f64; 2]>,
+    pub arap_iterations: usize,
+    pub flips_before_repair: usize,
+    pub flips_fixed: usize,
+    /// Final ARAP energy `sum_f A_f |J_f - R_f|^2`.
+    pub energy: f64,
+}
+
+/// Per-face linear-element data.
+struct Element {
+    /// Wedges of the three corners.
+    w: [usize; 3],
+    /// Unknowns of the corners' u and v.
+    x: [[usize; 3]; 2],
+    /// Gradients of the three hat functions in the face frame.
+    g: [[f64; 2]; 3],
+    area: f64,
+}
+
+/// The constrained system on the shared unknowns of [`unknowns`].
+struct System {
+    elements: Vec<Element>,
+    n_wedges: usize,
+    n_unknowns: usize,
+    vars: [Vec<usize>; 2],
+    constraints: Vec<Triplet>,
+    n_rows: usize,
+    kkt: Kkt,
+    solver: LdltSolver,
+}
+
+impl System {
+    fn a_triplets(elements: &[Element], weights: &[f64]) -> Vec<Triplet> {
+        let mut t = Vec::with_capacity(elements.len() * 18);
+        for (el, &wt) in elements.iter().zip(weights) {
+            for a in 0..3 {
+                for b in 0..3 {
+                    // Stiffness of (23): A_f grad(phi_a) . grad(phi_b) (full
+                    // matrix given; the strictly lower half is ignored).
+                    let v = wt * el.area * (el.g[a][0] * el.g[b][0] + el.g[a][1] * el.g[b][1]);
+                    for c in 0..2 {
+                        let (i, j) = (el.x[c][a], el.x[c][b]);
+                        if i <= j {
+                            t.push((i, j, v));
+                        }
+                    }
+                }
+            }
+        }
+        t
+    }
+
+    /// Global step: solves (23) for the target rotations `r` (rows in the face frame).
+    fn solve(&self, weights: &[f64], r: &[[[f64; 2]; 2]]) -> Result<Vec<[f64; 2]>, ParamError> {
+        let mut rhs = vec![0.0; self.n_unknowns + self.n_rows];
+        for ((el, &wt), rf) in self.elements.iter().zip(weights).zip(r) {
+            for k in 0..3 {
+                let g = el.g[k];
+                for c in 0..2 {
+                    rhs[el.x[c][k]] += wt * el.area * (g[0] * rf[c][0] + g[1] * rf[c][1]);
+                }
+            }
+        }
+        let x = self.solver.solve(&rhs)?;
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(ParamError::NotFinite { what: "global solve" });
+        }
+        // Redundant (consistent) rows only slow the refinement down through
+        // the multipliers; the constraints themselves must hold exactly.
+        let mut res = vec![0.0f64; self.n_rows];
+        for &(row, col, v) in &self.constraints {
+            res[row] += v * x[col];
+        }
+        let scale = x[..self.n_unknowns].iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        let worst = res.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if worst > 1e-7 * scale {
+            return Err(ParamError::ConstraintViolation { residual: worst / scale });
+        }
+        Ok((0..self.n_wedges).map(|w| [x[self.vars[0][w]], x[self.vars[1][w]]]).collect())
+    }
+
+    fn refactor(&mut self, weights: &[f64]) -> Result<(), ParamError> {
+        let a = Self::a_triplets(&self.elements, weights);
+        self.kkt.refill(&a, &self.constraints)?;
+        self.solver.factorize(&self.kkt.values)?;
+        Ok(())
+    }
+
+    fn jacobian(&self, f: usize, uv: &[[f64; 2]]) -> [[f64; 2]; 2] {
+        let el = &self.elements[f];
+        let mut j = [[0.0; 2]; 2];
+        for k in 0..3 {
+            let p = uv[el.w[k]];
+            for c in 0..2 {
+                j[c][0] += p[c] * el.g[k][0];
+                j[c][1] += p[c] * el.g[k][1];
+            }
+        }
+        j
+    }
+}
+
+/// Closest rotation to `j` (Appendix B.2, local step): `B = ½[[a+d, b-c], [c-b, a+d]]`,
+/// `R = B / sqrt(det B)`; `None` when `B` vanishes.
+pub fn closest_rotation(j: [[f64; 2]; 2]) -> Option<[[f64; 2]; 2]> {
+    let (a, b, c, d) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+    let (p, q) = (0.5 * (a + d), 0.5 * (b - c));
+    let n = (p * p + q * q).sqrt();
+    if n <= f64::MIN_POSITIVE || !n.is_finite() {
+        return None;
+    }
+    Some([[p / n, q / n], [-q / n, p / n]])
+}
+
+fn frob2(j: [[f64; 2]; 2], r: [[f64; 2]; 2]) -> f64 {
+    (0..2).flat_map(|a| (0..2).map(move |b| (a, b))).map(|(a, b)| (j[a][b] - r[a][b]).powi(2)).sum()
+}
+
+/// Signed UV area of face `f` relative to its orientation (≤ 0: flipped or degenerate).
+pub fn signed_uv_area(uv: [[f64; 2]; 3]) -> f64 {
+    0.5 * ((uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[2][0] - uv[0][0]) * (uv[1][1] - uv[0][1]))
+}
+
+fn flipped_faces(sys: &System, uv: &[[f64; 2]]) -> Vec<usize> {
+    (0..sys.elements.len())
+        .filter(|&f| {
+            let w = sys.elements[f].w;
+            !(signed_uv_area([uv[w[0]], uv[w[1]], uv[w[2]]]) > 0.0)
+        })
+        .collect()
+}
+
+/// Builds the constrained system, runs Poisson (23), ARAP and the repair.
+///
+/// Contract: returns UV per wedge of `cut` satisfying every constraint row
+/// (seam transitions along each [`super::cut_graph::SeamCurve`], isolines,
+/// one pin per disk component) to solver accuracy. The KKT matrix is
+/// factored once for Poisson + ARAP; the repair refactors (same pattern).
+#[allow(clippy::too_many_arguments)]
+pub fn solve(
+    mesh: &TriMesh,
+    _placement: &ConePlacement,
+    field: &CrossField,
+    cut: &CutGraph,
+    options: &ParamOptions,
+    progress: &mut dyn FnMut(ParamProgress),
+    clock: &mut Stopwatch,
+    timings: &mut ParamTimings,
+) -> Result<SeamlessResult, ParamError> {
+    progress(ParamProgress::Poisson);
+    let nf = mesh.n_faces();
+    let nw = cut.n_wedges;
+    let (vars, n_unknowns) = unknowns(mesh, field, cut);
+    let elements: Vec<Element> = (0..nf as u32)
+        .map(|f| {
+            let (q, area) = local_triangle(mesh, f);
+            // grad phi_k = rot90(q_{k+2} - q_{k+1}) / (2 A).
+            let g = [0, 1, 2].map(|k| {
+                let (a, b) = (q[(k + 1) % 3], q[(k + 2) % 3]);
+                [-(b[1] - a[1]) / (2.0 * area), (b[0] - a[0]) / (2.0 * area)]
+            });
+            let c = 3 * f as usize;
+            let w = [0, 1, 2].map(|k| cut.wedge[c + k] as usize);
+            Element { w, x: [w.map(|i| vars[0][i]), w.map(|i| vars[1][i])], g, area }
+        })
+        .collect();
+
+    let (constraints, n_rows) = constraint_rows(mesh, cut, &vars, n_unknowns);
+    let mut weights = vec![1.0; nf];
+    let a = System::a_triplets(&elements, &weights);
+    let kkt = Kkt::assemble(&a, n_unknowns, &constraints, n_rows)?;
+    let mut solver = LdltSolver::with_options(
+        &kkt.pattern,
+        &kkt.signs,
+        // Small regularization: the constraint pivots are exact zeros before
+        // their primal neighbours are eliminated; a smaller delta refines faster here.
+        SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..SolverOptions::default() },
+    )?;
+    solver.factorize(&kkt.values)?;
+    let sys = System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver };
+    let mut sys = sys;
+
+    // Poisson (23) with the field's target Jacobians (B.1).
+    let mut r: Vec<[[f64; 2]; 2]> = (0..nf).map(|f| field.target(f)).collect();
+    let mut uv = sys.solve(&weights, &r)?;
+    timings.poisson = clock.lap();
+
+    let fixed: Vec<bool> = (0..nf)
+        .map(|f| options.fix_feature_rotations && (0..3).any(|k| field.isoline[3 * f + k] != NO_ISOLINE))
+        .collect();
+    let (iterations, mut energy) = arap(&sys, &weights, &fixed, &mut r, &mut uv, options, 0, progress)?;
+    timings.arap = clock.lap();
+
+    // Fold-over repair: raise the weight of flipped triangles and their
+    // neighbours (keeps every constraint: only A changes), re-run ARAP.
+    let mut flips = flipped_faces(&sys, &uv);
+    let flips_before = flips.len();
+    let (mut best_uv, mut best_flips) = (uv.clone(), flips.len());
+    let mut round = 0;
+    while !flips.is_empty() && round < options.repair_rounds {
+        round += 1;
+        progress(ParamProgress::Repair { round, flips: flips.len() });
+        for &f in &flips {
+            weights[f] = (weights[f] * 10.0).min(1e6);
+            for k in 0..3 {
+                let t = mesh.twin(3 * f as u32 + k);
+                if let Some(g) = mesh.face(t) {
+                    weights[g as usize] = (weights[g as usize] * 3.0).min(1e6);
+                }
+            }
+        }
+        sys.refactor(&weights)?;
+        let (_, e) = arap(&sys, &weights, &fixed, &mut r, &mut uv, options, 10, &mut |_| {})?;
+        energy = e;
+        flips = flipped_faces(&sys, &uv);
+        if flips.len() < best_flips {
+            best_flips = flips.len();
+            best_uv = uv.clone();
+        }
+    }
+    timings.repair = clock.lap();
+    Ok(SeamlessResult {
+        uv: best_uv,
+        arap_iterations: iterations,
+        flips_before_repair: flips_before,
+        flips_fixed: flips_before - best_flips,
+        energy,
+    })
+}
+
+/// ARAP local/global iterations (eq. 4) from `uv`; `cap` overrides the
+/// iteration limit when non-zero. Returns (iterations, energy).
+#[allow(clippy::too_many_arguments)]
+fn arap(
+    sys: &System,
+    weights: &[f64],
+    fixed: &[bool],
+    r: &mut [[[f64; 2]; 2]],
+    uv: &mut Vec<[f64; 2]>,
+    options: &ParamOptions,
+    cap: usize,
+    progress: &mut dyn FnMut(ParamProgress),
+) -> Result<(usize, f64), ParamError> {
+    let max = if cap > 0 { cap.min(options.max_arap_iterations.max(cap)) } else { options.max_arap_iterations };
+    let energy = |r: &[[[f64; 2]; 2]], uv: &[[f64; 2]]| -> f64 {
+        (0..sys.elements.len()).map(|f| weights[f] * sys.elements[f].area * frob2(sys.jacobian(f, uv), r[f])).sum()
+    };
+    let mut prev = f64::INFINITY;
+    let mut e = energy(r, uv);
+    let mut it = 0;
+    while it < max {
+        it += 1;
+        progress(ParamProgress::Arap { iteration: it, max });
+        // Local step: closest rotation (B.2), kept fixed next to features.
+        for f in 0..sys.elements.len() {
+            if !fixed[f] {
+                if let Some(rot) = closest_rotation(sys.jacobian(f, uv)) {
+                    r[f] = rot;
+                }
+            }
+        }
+        // Global step: (23) with the new R, same factorization.
+        *uv = sys.solve(weights, r)?;
+        prev = prev.min(e);
+        e = energy(r, uv);
+        if prev.is_finite() && (prev - e) <= options.arap_tolerance * prev.max(f64::MIN_POSITIVE) {
+            break;
+        }
+    }
+    Ok((it, e))
+}
+
+/// Unknown index of every wedge's u and v: isolines (`u_a = u_b` or
+/// `v_a = v_b` along every feature and boundary edge, both sides) are
+/// enforced by sharing one unknown per class of equal coordinates, which
+/// also removes the rows they would make redundant.
+fn unknowns(mesh: &TriMesh, field: &CrossField, cut: &CutGraph) -> ([Vec<usize>; 2], usize) {
+    let nw = cut.n_wedges;
+    let mut uf: [Vec<u32>; 2] = [(0..nw as u32).collect(), (0..nw as u32).collect()];
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    for h in 0..3 * mesh.n_faces() as u32 {
+        let c = field.isoline[h as usize];
+        if c == NO_ISOLINE {
+            continue;
+        }
+        let c = c as usize;
+        let (a, b) = (cut.wedge[h as usize], cut.wedge[mesh.next(h) as usize]);
+        let (ra, rb) = (find(&mut uf[c], a), find(&mut uf[c], b));
+        uf[c][ra as usize] = rb;
+    }
+    let mut n = 0;
+    let mut var: [Vec<usize>; 2] = [vec![usize::MAX; nw], vec![usize::MAX; nw]];
+    for c in 0..2 {
+        let mut id = vec![usize::MAX; nw];
+        for w in 0..nw as u32 {
+            let r = find(&mut uf[c], w) as usize;
+            if id[r] == usize::MAX {
+                id[r] = n;
+                n += 1;
+            }
+            var[c][w as usize] = id[r];
+        }
+    }
+    (var, n)
+}
+
+/// Constraint rows on the unknowns of [`unknowns`]: seam transitions (B.2)
+/// and pins; rows that vanish or repeat are dropped.
+fn constraint_rows(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2], n_unknowns: usize) -> (Vec<Triplet>, usize) {
+    let var = |w: u32, c: usize| vars[c][w as usize];
+    let mut rows: Vec<Vec<(usize, i64)>> = Vec::new();
+    let mut n = 0usize;
+    let mut seen: std::collections::HashSet<Vec<(usize, i64)>> = std::collections::HashSet::new();
+    let mut push_row = |entries: &mut Vec<(usize, i64)>, rows: &mut Vec<Vec<(usize, i64)>>, n: &mut usize| {
+        entries.sort_unstable_by_key(|e| e.0);
+        let mut merged: Vec<(usize, i64)> = Vec::new();
+        for &(i, v) in entries.iter() {
+            match merged.last_mut() {
+                Some(l) if l.0 == i => l.1 += v,
+                _ => merged.push((i, v)),
+            }
+        }
+        merged.retain(|e| e.1 != 0);
+        entries.clear();
+        if merged.is_empty() {
+            return;
+        }
+        if merged[0].1 < 0 {
+            for e in merged.iter_mut() {
+                e.1 = -e.1;
+            }
+        }
+        if !seen.insert(merged.clone()) {
+            return;
+        }
+        rows.push(merged);
+        *n += 1;
+    };
+    let mut entries = Vec::new();
+    for curve in &cut.curves {
+        // r = Rot(-m pi/2): f_g = r f_f + t along the whole curve.
+        let rot: [[i64; 2]; 2] = match curve.matching.rem_euclid(4) {
+            0 => [[1, 0], [0, 1]],
+            1 => [[0, 1], [-1, 0]],
+            2 => [[-1, 0], [0, -1]],
+            _ => [[0, -1], [1, 0]],
+        };
+        let hs = &curve.halfedges;
+        // Wedge pairs (f side, g side) at the vertices of the curve.
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(hs.len() + 1);
+        let t0 = mesh.twin(hs[0]);
+        pairs.push((cut.wedge[hs[0] as usize], cut.wedge[mesh.next(t0) as usize]));
+        for &h in hs {
+            let t = mesh.twin(h);
+            pairs.push((cut.wedge[mesh.next(h) as usize], cut.wedge[t as usize]));
+        }
+        if curve.closed && pairs.first() == pairs.last() {
+            pairs.pop();
+        }
+        for win in pairs.windows(2) {
+            let ((fa, ga), (fb, gb)) = (win[0], win[1]);
+            for c in 0..2 {
+                // f_g(b) - f_g(a) = r (f_f(b) - f_f(a))   (B.2, t eliminated).
+                entries.push((var(gb, c), 1));
+                entries.push((var(ga, c), -1));
+                for d in 0..2 {
+                    if rot[c][d] != 0 {
+                        entries.push((var(fb, d), -rot[c][d]));
+                        entries.push((var(fa, d), rot[c][d]));
+                    }
+                }
+                push_row(&mut entries, &mut rows, &mut n);
+            }
+        }
+    }
+    for &p in &cut.pins {
+        for c in 0..2 {
+            entries.push((var(p, c), 1));
+            push_row(&mut entries, &mut rows, &mut n);
+        }
+    }
+    // Drop rows that are combinations of earlier ones (exact redundancy
+    // makes the KKT singular); pins come last and are never redundant.
+    let keep = independent_rows(&rows, n_unknowns);
+    let mut triplets = Vec::new();
+    let mut m = 0;
+    for (row, k) in rows.iter().zip(keep) {
+        if k {
+            triplets.extend(row.iter().map(|&(i, v)| (m, i, v as f64)));
+            m += 1;
+        }
+    }
+    (triplets, m)
+}
+
+/// Incremental sparse Gaussian elimination: `keep[i]` is false when row `i`
+/// is a linear combination of the kept rows before it.
+fn independent_rows(rows: &[Vec<(usize, i64)>], n_vars: usize) -> Vec<bool> {
+    use std::cmp::Reverse;
+    use std::collections::{BinaryHeap, HashMap};
+    let mut pivot_of = vec![usize::MAX; n_vars];
+    let mut stored: Vec<(usize, Vec<(usize, f64)>)> = Vec::new();
+    let mut keep = vec![false; rows.len()];
+    for (ri, r) in rows.iter().enumerate() {
+        let mut work: HashMap<usize, f64> = r.iter().map(|&(i, v)| (i, v as f64)).collect();
+        let mut heap: BinaryHeap<Reverse<(usize, usize)>> =
+            work.keys().filter(|&&v| pivot_of[v] != usize::MAX).map(|&v| Reverse((pivot_of[v], v))).collect();
+        while let Some(Reverse((si, var))) = heap.pop() {
+            let c = match work.get(&var) {
+                Some(&c) if c.abs() > 1e-12 => c,
+                _ => continue,
+            };
+            let srow = &stored[si].1;
+            let pc = srow.iter().find(|e| e.0 == var).map_or(1.0, |e| e.1);
+            let factor = c / pc;
+            for &(v, a) in srow {
+                *work.entry(v).or_insert(0.0) -= factor * a;
+                if v != var && pivot_of[v] != usize::MAX {
+                    heap.push(Reverse((pivot_of[v], v)));
+                }
+            }
+            work.remove(&var);
+        }
+        work.retain(|_, c| c.abs() > 1e-9);
+        let Some((&pv, _)) = work.iter().max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()).then(b.0.cmp(a.0))) else {
+            continue;
+        };
+        keep[ri] = true;
+        pivot_of[pv] = stored.len();
+        stored.push((pv, work.into_iter().collect()));
+    }
+    keep
+}
