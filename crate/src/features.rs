@@ -205,6 +205,10 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
 pub struct Refined {
     pub mesh: TriMesh,
     pub features: FeatureSet,
+    /// Refined face → the input face it lies in.
+    pub original_face: Vec<u32>,
+    /// Refined vertex → input vertex (`NONE` for inserted midpoints).
+    pub original_vertex: Vec<u32>,
     /// Edges split (one new vertex each).
     pub splits: usize,
 }
@@ -258,6 +262,8 @@ pub fn split_doubly_constrained(mesh: &TriMesh, features: &FeatureSet) -> Option
             }
         }
         let mut triangles = Vec::with_capacity(m.n_faces() + 2 * split.iter().filter(|&&x| x).count());
+        let mut parent_face = Vec::with_capacity(triangles.capacity());
+        let face_origin = |face: u32| current.as_ref().map_or(face, |r| r.original_face[face as usize]);
         for face in 0..m.n_faces() as u32 {
             let hs = m.face_halfedges(face);
             let v = m.faces()[face as usize];
@@ -268,8 +274,12 @@ pub fn split_doubly_constrained(mesh: &TriMesh, features: &FeatureSet) -> Option
                     let (a, b, c) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
                     triangles.push([a, x, c]);
                     triangles.push([x, b, c]);
+                    parent_face.extend([face_origin(face); 2]);
                 }
-                None => triangles.push(v),
+                None => {
+                    triangles.push(v);
+                    parent_face.push(face_origin(face));
+                }
             }
         }
         let refined = TriMesh::from_welded_arrays(positions, triangles)
@@ -288,7 +298,18 @@ pub fn split_doubly_constrained(mesh: &TriMesh, features: &FeatureSet) -> Option
             }
         }
         let splits = current.as_ref().map_or(0, |r| r.splits) + split.iter().filter(|&&x| x).count();
-        current = Some(Refined { mesh: refined, features: feats, splits });
+        let original_vertex = refined
+            .welded_to_source()
+            .iter()
+            .map(|&src| {
+                if (src as usize) >= m.n_vertices() {
+                    NONE
+                } else {
+                    current.as_ref().map_or(src, |r| r.original_vertex[src as usize])
+                }
+            })
+            .collect();
+        current = Some(Refined { mesh: refined, features: feats, splits, original_face: parent_face, original_vertex });
     }
     // Rebuild once from the final arrays so the mesh is its own source
     // (`source_to_welded` is the identity; edge ids are unchanged).

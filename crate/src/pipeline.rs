@@ -50,10 +50,58 @@ pub struct Solution<'a> {
     pub features: Cow<'a, FeatureSet>,
     /// Edges split before solving (0: `mesh` is the input).
     pub splits: usize,
+    /// When split: solved face → input face and solved vertex → input
+    /// vertex (`NONE` for inserted midpoints).
+    pub original_face: Option<Vec<u32>>,
+    pub original_vertex: Option<Vec<u32>>,
     pub placement: ConePlacement,
     pub param: Parametrization,
     /// Seconds spent refining.
     pub refine_seconds: f64,
+}
+
+impl Solution<'_> {
+    /// The UVs per corner of the INPUT mesh (`3 f + k`): where faces were
+    /// split, each input corner takes the UV of that corner in the sub-face
+    /// containing it (for display; exports use the solved mesh exactly).
+    pub fn input_corner_uv(&self, input: &TriMesh) -> Vec<[f64; 2]> {
+        let (Some(of), Some(ov)) = (&self.original_face, &self.original_vertex) else {
+            return self.param.uv.clone();
+        };
+        let mut uv = vec![[0.0; 2]; 3 * input.n_faces()];
+        for (r, tri) in self.mesh.faces().iter().enumerate() {
+            let f = of[r] as usize;
+            for (k, &v) in tri.iter().enumerate() {
+                let o = ov[v as usize];
+                if let Some(j) = input.faces()[f].iter().position(|&w| w == o) {
+                    uv[3 * f + j] = self.param.uv[3 * r + k];
+                }
+            }
+        }
+        uv
+    }
+
+    /// Seam edges as ids of the INPUT mesh (seams along inserted edges are dropped).
+    pub fn input_seam_edges(&self, input: &TriMesh) -> Vec<u32> {
+        let Some(ov) = &self.original_vertex else {
+            return self.param.seam_edges.clone();
+        };
+        let mut out: Vec<u32> = self
+            .param
+            .seam_edges
+            .iter()
+            .filter_map(|&e| {
+                let [a, b] = self.mesh.edge_vertices(e).map(|v| ov[v as usize]);
+                if a == crate::mesh::NONE || b == crate::mesh::NONE {
+                    return None;
+                }
+                input.outgoing(a).find(|&h| input.head(h) == b).map(|h| input.edge(h))
+            })
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
 }
 
 /// Solves on `mesh` with `features` (see the module doc).
@@ -64,14 +112,14 @@ pub fn solve<'a>(
     progress: &mut dyn FnMut(SolveProgress),
 ) -> Result<Solution<'a>, SolveError> {
     let mut clock = Stopwatch::start();
-    let (mesh, features, splits) = match split_doubly_constrained(mesh, features) {
-        Some(r) => (Cow::Owned(r.mesh), Cow::Owned(r.features), r.splits),
-        None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0),
+    let (mesh, features, splits, original_face, original_vertex) = match split_doubly_constrained(mesh, features) {
+        Some(r) => (Cow::Owned(r.mesh), Cow::Owned(r.features), r.splits, Some(r.original_face), Some(r.original_vertex)),
+        None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None),
     };
     let refine_seconds = clock.lap();
     let placement = cones::place_cones(&mesh, &features, &options.cones, &mut |p| progress(SolveProgress::Cones(p)))
         .map_err(SolveError::Cones)?;
     let param = param::parametrize(&mesh, &placement, &options.param, &mut |p| progress(SolveProgress::Param(p)))
         .map_err(SolveError::Param)?;
-    Ok(Solution { mesh, features, splits, placement, param, refine_seconds })
+    Ok(Solution { mesh, features, splits, original_face, original_vertex, placement, param, refine_seconds })
 }

@@ -2,7 +2,10 @@
 //!
 //! Errors cross as JS `Error`s carrying the library's one-line message.
 
-use crate::cones::{self, ConeOptions, Progress};
+use crate::cones::{self, ConeOptions, ConePlacement, Progress};
+use crate::export::{self, ExportInput, ExportOptions};
+use crate::param::{self, ParamOptions, ParamProgress};
+use crate::pipeline::{self, SolveOptions, SolveProgress};
 use crate::features::FeatureSet;
 use crate::io::{self, InputFile};
 use crate::mesh::{self, MeshReport, RawMesh, TriMesh};
@@ -34,7 +37,6 @@ pub fn import_mesh(files: Array) -> Result<JsValue, JsError> {
 /// [`TriMesh`] that cone placement and parametrization run on.
 #[wasm_bindgen]
 pub struct MeshSession {
-    #[allow(dead_code)]
     raw: RawMesh,
     report: MeshReport,
     positions: Vec<[f64; 3]>,
@@ -129,35 +131,83 @@ impl MeshSession {
     ) -> Result<JsValue, JsError> {
         let mesh = self.valid_mesh()?;
         let features = self.features(mesh, feature_edges)?;
-        let (lo, hi) = cones::ALPHA_RANGE;
-        if !(lo..=hi).contains(&alpha_smooth) {
-            return Err(JsError::new(&format!("alpha_smooth {alpha_smooth} is outside {lo}..{hi}")));
-        }
-        let options = ConeOptions { alpha_smooth, miq, ..ConeOptions::default() };
+        let options = self.cone_options(alpha_smooth, miq)?;
         let mut report = |p: Progress| {
-            let (stage, a, b) = match p {
-                Progress::Topology { component, components } => ("topology", component, components),
-                Progress::Rounding { round, free, .. } => ("rounding", round, free),
-                Progress::ConeMoves { pass, .. } => ("cone moves", pass, 0),
-                Progress::PairCancellation { removed, .. } => ("pair cancellation", removed, 0),
-            };
+            let (stage, a, b) = cone_stage(&p);
             let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
         };
         let r = cones::place_cones(mesh, &features, &options, &mut report).map_err(|e| JsError::new(&e.to_string()))?;
-        let out = Object::new();
-        set(&out, "cones", &to_js(&r.cones)?)?;
-        set(&out, "boundary_corners", &to_js(&r.boundary_corners)?)?;
-        set(&out, "components", &to_js(&r.components)?)?;
-        set(&out, "rounds", &(r.rounds as f64).into())?;
-        set(&out, "energy", &r.energy.into())?;
-        set(&out, "phi_rms", &r.phi_rms.into())?;
-        set(&out, "timings", &to_js(&r.timings)?)?;
-        set(&out, "feature_edges", &(features.len() as f64).into())?;
+        Ok(cone_result(&r, features.len())?.into())
+    }
+}
+
+#[wasm_bindgen]
+impl MeshSession {
+    /// Places cones and computes the seamless aligned map (the whole method).
+    /// Returns the `place_cones` fields plus `uv` (Float32Array, 2 per input
+    /// face corner `3 f + k`), `seam_edges` (input edge ids), `metrics`
+    /// (with `per_face_distortion`), `timings`, `split_edges`, `glb`
+    /// (Uint8Array) and `obj` (string) of the solved mesh.
+    pub fn solve(
+        &self,
+        feature_edges: &[u32],
+        alpha_smooth: f64,
+        miq: bool,
+        progress: &Function,
+    ) -> Result<JsValue, JsError> {
+        let mesh = self.valid_mesh()?;
+        let features = self.features(mesh, feature_edges)?;
+        let options = SolveOptions { cones: self.cone_options(alpha_smooth, miq)?, param: ParamOptions::default() };
+        let mut report = |p: SolveProgress| {
+            let (stage, a, b) = match p {
+                SolveProgress::Cones(p) => cone_stage(&p),
+                SolveProgress::Param(p) => match p {
+                    ParamProgress::Field => ("cross-field", 0, 0),
+                    ParamProgress::Cut => ("cut", 0, 0),
+                    ParamProgress::Poisson => ("poisson", 0, 0),
+                    ParamProgress::Arap { iteration, max } => ("arap", iteration, max),
+                    ParamProgress::Repair { round, flips } => ("repair", round, flips),
+                },
+            };
+            let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
+        };
+        let sol = pipeline::solve(mesh, &features, &options, &mut report).map_err(|e| JsError::new(&e.to_string()))?;
+        let out = cone_result(&sol.placement, sol.features.len())?;
+        let uv: Vec<f32> = sol.input_corner_uv(mesh).iter().flat_map(|p| p.map(|c| c as f32)).collect();
+        set(&out, "uv", &Float32Array::from(&uv[..]).into())?;
+        set(&out, "seam_edges", &Uint32Array::from(&sol.input_seam_edges(mesh)[..]).into())?;
+        let metrics = to_js(&sol.param.metrics)?;
+        let m: Object = metrics.clone().into();
+        set(&m, "below_0_2", &sol.param.metrics.fraction_below_0_2.into())?;
+        set(&m, "below_0_3", &sol.param.metrics.fraction_below_0_3.into())?;
+        let per_face: Vec<f32> = param::metrics::face_distortion(mesh, &sol.input_corner_uv(mesh), sol.param.metrics.scale)
+            .iter()
+            .map(|&d| d as f32)
+            .collect();
+        set(&m, "per_face_distortion", &Float32Array::from(&per_face[..]).into())?;
+        set(&out, "metrics", &metrics)?;
+        set(&out, "param_timings", &to_js(&sol.param.timings)?)?;
+        set(&out, "split_edges", &(sol.splits as f64).into())?;
+        // Exports of the solved mesh (with any split edges), exactly.
+        let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
+        let input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &sol.param.uv)
+            .map_err(|e| JsError::new(&e.to_string()))?;
+        let glb = export::write_glb(&input, &ExportOptions::default());
+        set(&out, "glb", &Uint8Array::from(&glb[..]).into())?;
+        set(&out, "obj", &export::write_obj(&input, &ExportOptions::default()).into())?;
         Ok(out.into())
     }
 }
 
 impl MeshSession {
+    fn cone_options(&self, alpha_smooth: f64, miq: bool) -> Result<ConeOptions, JsError> {
+        let (lo, hi) = cones::ALPHA_RANGE;
+        if !(lo..=hi).contains(&alpha_smooth) {
+            return Err(JsError::new(&format!("alpha_smooth {alpha_smooth} is outside {lo}..{hi}")));
+        }
+        Ok(ConeOptions { alpha_smooth, miq, ..ConeOptions::default() })
+    }
+
     fn valid_mesh(&self) -> Result<&TriMesh, JsError> {
         self.mesh.as_ref().ok_or_else(|| {
             let first = self.report.problems.iter().find(|p| p.is_blocking()).map(|p| p.to_string()).unwrap_or_default();
@@ -175,6 +225,30 @@ impl MeshSession {
         }
         Ok(set)
     }
+}
+
+/// Stage name and two counters of a cone-placement progress report.
+fn cone_stage(p: &Progress) -> (&'static str, usize, usize) {
+    match *p {
+        Progress::Topology { component, components } => ("topology", component, components),
+        Progress::Rounding { round, free, .. } => ("rounding", round, free),
+        Progress::ConeMoves { pass, .. } => ("cone moves", pass, 0),
+        Progress::PairCancellation { removed, .. } => ("pair cancellation", removed, 0),
+    }
+}
+
+/// The cone-placement fields shared by `place_cones` and `solve`.
+fn cone_result(r: &ConePlacement, feature_edges: usize) -> Result<Object, JsError> {
+    let out = Object::new();
+    set(&out, "cones", &to_js(&r.cones)?)?;
+    set(&out, "boundary_corners", &to_js(&r.boundary_corners)?)?;
+    set(&out, "components", &to_js(&r.components)?)?;
+    set(&out, "rounds", &(r.rounds as f64).into())?;
+    set(&out, "energy", &r.energy.into())?;
+    set(&out, "phi_rms", &r.phi_rms.into())?;
+    set(&out, "timings", &to_js(&r.timings)?)?;
+    set(&out, "feature_edges", &(feature_edges as f64).into())?;
+    Ok(out)
 }
 
 fn to_js<T: serde::Serialize>(value: &T) -> Result<JsValue, JsError> {

@@ -63,6 +63,20 @@ pub fn face_jacobians(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<([[f64; 2]; 2], f6
         .collect()
 }
 
+/// Per-face distortion `min_R |s J_f - R|_F` at UV scale `s` (the
+/// quantity eq. (19) averages), for heat maps and histograms.
+pub fn face_distortion(mesh: &TriMesh, uv: &[[f64; 2]], s: f64) -> Vec<f64> {
+    face_jacobians(mesh, uv)
+        .iter()
+        .map(|&(j, _)| {
+            let (a, b, c, d) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+            let conf = (0.25 * ((a + d).powi(2) + (b - c).powi(2))).sqrt();
+            let anti = (0.25 * ((a - d).powi(2) + (b + c).powi(2))).sqrt();
+            tri_distortion(conf, anti, s)
+        })
+        .collect()
+}
+
 /// Sum of the UV corner angles around every vertex of `mesh` (all wedges):
 /// `2 pi - k pi/2` at an interior vertex of cone index `k` for a seamless,
 /// fold-free map.
