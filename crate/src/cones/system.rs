@@ -525,6 +525,27 @@ impl ComponentSystem<'_> {
             .sum()
     }
 
+    /// Unit transfers that cancel every interior cone: each quarter turn of a
+    /// positive cone goes to the nearest negative cone with index left.
+    fn pairing(&self, cones: &[(usize, i64)]) -> Vec<(usize, usize, i64)> {
+        let pos = |i: usize| self.mesh.position(self.tree.vertices[i]);
+        let mut left: Vec<(usize, i64)> = cones.iter().filter(|c| c.1 < 0).copied().collect();
+        let mut moves = Vec::new();
+        for &(i, ki) in cones.iter().filter(|c| c.1 > 0) {
+            for _ in 0..ki {
+                let Some(best) = (0..left.len()).filter(|&n| left[n].1 < 0).min_by(|&a, &b| {
+                    let d = |n: usize| crate::vec3::norm(crate::vec3::sub(pos(i), pos(left[n].0)));
+                    d(a).total_cmp(&d(b))
+                }) else {
+                    break;
+                };
+                moves.push((i, left[best].0, 1));
+                left[best].1 += 1;
+            }
+        }
+        moves
+    }
+
     /// Interior cones as (local vertex, k).
     fn interior_cones(&self) -> Vec<(usize, i64)> {
         let k = self.vertex_k();
@@ -580,6 +601,26 @@ impl ComponentSystem<'_> {
     pub fn cancel_pairs(&mut self, nearest: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
         let mut removed = 0;
         let mut current = self.objective();
+        // Global candidate: when the interior indices sum to zero, all cones
+        // may cancel at once (a single pair's removal can cost energy while
+        // removing all of them lowers it, e.g. on a torus of revolution).
+        let cones = self.interior_cones();
+        if !cones.is_empty() && cones.iter().map(|c| c.1).sum::<i64>() == 0 {
+            let moves = self.pairing(&cones);
+            for &(i, j, a) in &moves {
+                self.transfer(i, j, a);
+            }
+            self.solve()?;
+            let e = self.objective();
+            if e < current * (1.0 - 1e-9) {
+                current = e;
+                removed += moves.len();
+            } else {
+                for &(i, j, a) in moves.iter().rev() {
+                    self.transfer(j, i, a);
+                }
+            }
+        }
         loop {
             progress(removed);
             let cones = self.interior_cones();
