@@ -100,10 +100,7 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
 
 #[test]
 fn fandisk_with_sharp_features() {
-    // Known shortfall: a few triangles fold over next to negative cones and
-    // acute feature joints (13 of 12 982 at the time of writing); the
-    // repair step does not remove them yet.
-    run("fandisk.obj", Some(60.0), 0.3, 0.002);
+    run("fandisk.obj", Some(60.0), 0.23, 0.0);
 }
 
 #[test]

@@ -252,13 +252,15 @@ pub fn place_cones(
 }
 
 /// Turning integer of every boundary vertex, rounded from the geometry:
-/// `round((pi - angle sum) / (pi/2))` (0 elsewhere).
+/// `round((pi - angle sum) / (pi/2))`, at most 1 so every boundary corner
+/// keeps a parametric angle of at least 90° (a sector sharper than 45°
+/// would otherwise round to a zero angle and collapse); 0 elsewhere.
 pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
     let sums = crate::operators::angle_sums(mesh.positions(), mesh.faces());
     (0..mesh.n_vertices() as u32)
         .map(|v| {
             if mesh.is_boundary_vertex(v) {
-                ((std::f64::consts::PI - sums[v as usize]) / FRAC_PI_2).round() as i32
+                (((std::f64::consts::PI - sums[v as usize]) / FRAC_PI_2).round() as i32).min(1)
             } else {
                 0
             }

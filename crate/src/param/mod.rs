@@ -43,7 +43,7 @@ pub struct ParamOptions {
 
 impl Default for ParamOptions {
     fn default() -> Self {
-        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 4 }
+        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 12 }
     }
 }
 

@@ -214,10 +214,16 @@ pub fn solve(
     let flips_before = flips.len();
     let (mut best_uv, mut best_flips) = (uv.clone(), flips.len());
     let mut round = 0;
+    let mut pinned = fixed.clone();
     while !flips.is_empty() && round < options.repair_rounds {
         round += 1;
         progress(ParamProgress::Repair { round, flips: flips.len() });
         for &f in &flips {
+            // Hold a flipped triangle's target at the field frame (an
+            // orientation-preserving rotation) instead of the closest rotation
+            // to its flipped Jacobian, and weight it up.
+            r[f] = field.target(f);
+            pinned[f] = true;
             weights[f] = (weights[f] * 10.0).min(1e6);
             for k in 0..3 {
                 let t = mesh.twin(3 * f as u32 + k);
@@ -227,7 +233,7 @@ pub fn solve(
             }
         }
         sys.refactor(&weights)?;
-        let (_, e) = arap(&sys, &weights, &fixed, &mut r, &mut uv, options, 10, &mut |_| {})?;
+        let (_, e) = arap(&sys, &weights, &pinned, &mut r, &mut uv, options, 10, &mut |_| {})?;
         energy = e;
         flips = flipped_faces(&sys, &uv);
         if flips.len() < best_flips {
