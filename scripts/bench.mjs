@@ -171,6 +171,100 @@ function wasmNodeImport(ctx) {
   return rows;
 }
 
+/** The fandisk subdivided `levels` times (cached in the temp dir), e.g. 2 → 207 k faces. */
+function subObj(source, levels) {
+  const dir = path.join(os.tmpdir(), 'conemap-bench');
+  const file = path.join(dir, `fandisk-sub${levels}.obj`);
+  let mesh = readObj(source);
+  const faces = (mesh.triangles.length / 3) * 4 ** levels;
+  if (fs.existsSync(file) && fs.statSync(file).mtimeMs >= fs.statSync(source).mtimeMs) return { file, faces };
+  fs.mkdirSync(dir, { recursive: true });
+  for (let i = 0; i < levels; i++) mesh = subdivide(mesh);
+  writeObj(mesh, `${file}.tmp`);
+  fs.renameSync(`${file}.tmp`, file);
+  return { file, faces };
+}
+
+/** Cone placement in wasm under node: fandisk with its sharp edges (> 60°) as features, α = 1. */
+function wasmNodeCones(ctx) {
+  const pkg = path.join(root, 'build/pkg-node/conemap.js');
+  if (!fs.existsSync(pkg)) return { skipped: 'build/pkg-node missing (run npm run build)' };
+  const wasm = createRequire(import.meta.url)(pkg);
+  const file = ctx.inputs[0].file;
+  const session = wasm.MeshSession.open([{ name: path.basename(file), bytes: new Uint8Array(fs.readFileSync(file)) }]);
+  try {
+    let t0 = performance.now();
+    const sharp = session.sharp_edges(60);
+    const sharpMs = performance.now() - t0;
+    t0 = performance.now();
+    const r = session.place_cones(sharp, 1, false, () => {});
+    const conesMs = performance.now() - t0;
+    const input = path.basename(file);
+    return [
+      { stage: 'sharp_edges(60°)', input, ms: sharpMs, note: `${sharp.length} edges` },
+      { stage: 'place_cones', input, ms: conesMs, note: `${sharp.length} features, α=1: ${r.cones.length} cones, ${r.rounds} rounds` },
+    ];
+  } finally {
+    session.free();
+  }
+}
+
+/**
+ * The page's feature editor and solve on the main thread's clock: edge picking
+ * (raycast without BVH + nearest side in screen space) and a sharp-edge pass on a
+ * 207 k-face mesh, and Run (cone placement) on the fandisk.
+ */
+async function browserFeatures(ctx) {
+  const { findChromium, launchChromium } = await import('./lib/chromium.mjs');
+  if (!findChromium()) return { skipped: 'no Chromium (set CHROMIUM_PATH or apt-get install chromium)' };
+  const { startServer } = await import('./serve.mjs');
+  const server = await startServer({ root: path.join(root, 'dist'), port: 0 });
+  const browser = await launchChromium();
+  try {
+    const page = await browser.context.newPage();
+    await page.goto(server.url);
+    await page.waitForFunction(() => window.__conemap?.state === 'ready', null, { timeout: 120_000 });
+    const rows = [];
+    // Run on the fandisk: sharp edges > 60° as features, α = 1.
+    await page.getByTestId('sharp-toggle').check();
+    await page.getByTestId('sharp-angle').fill('60');
+    await page.waitForFunction(() => window.__conemap.features > 0, null, { timeout: 60_000 });
+    await page.getByTestId('alpha').fill('0');
+    let t0 = Date.now();
+    await page.getByTestId('run').click();
+    await page.waitForFunction(() => window.__conemap.solves > 0, null, { timeout: 300_000 });
+    const h = await page.evaluate(() => window.__conemap);
+    rows.push({ stage: 'Run → result shown', input: 'fandisk.obj', faces: 12946, ms: Date.now() - t0, note: h.result ? `${h.result.cones} cones${h.result.uv ? ', with UVs (solve)' : ' (place_cones only)'}` : `failed: ${h.solveError}` });
+    // Picking and sharp edges on the 207 k-face mesh.
+    const mid = subObj(ctx.inputs[0].file, 2);
+    const n = h.loads;
+    await page.getByTestId('file-input').setInputFiles(mid.file);
+    await page.waitForFunction((k) => window.__conemap.loads > k && window.__conemap.state !== 'loading', n, { timeout: 300_000 });
+    const input = path.basename(mid.file);
+    const pick = await page.evaluate(() => {
+      const r = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
+      const times = [];
+      let hits = 0;
+      for (let i = 0; i < 15; i++) {
+        const t = performance.now();
+        if (window.__conemapTest.edgeAt(r.left + r.width * (0.35 + 0.02 * i), r.top + r.height * (0.4 + 0.01 * i)) >= 0) hits++;
+        times.push(performance.now() - t);
+      }
+      times.sort((a, b) => a - b);
+      return { median: times[7], max: times[14], hits };
+    });
+    rows.push({ stage: 'pick an edge (click)', input, faces: mid.faces, ms: pick.median, note: `max ${pick.max.toFixed(1)} ms, ${pick.hits}/15 hits` });
+    t0 = Date.now();
+    await page.getByTestId('sharp-toggle').check();
+    await page.waitForFunction(() => window.__conemap.features > 0, null, { timeout: 120_000 });
+    rows.push({ stage: 'sharp edges > 60° marked', input, faces: mid.faces, ms: Date.now() - t0, note: 'worker + feature lines' });
+    return rows;
+  } finally {
+    await browser.close();
+    await server.close();
+  }
+}
+
 async function browserLoad(ctx) {
   const big = ctx.inputs.find((i) => i.faces >= MIN_BIG_FACES);
   if (!big) return { skipped: 'no ≥1 M-face input (--quick)' };
@@ -253,7 +347,9 @@ const BENCHES = [
   { env: 'native', stage: 'import', run: nativeImport, enabled: !args.has('--no-native') },
   { env: 'native', stage: 'ldlt', run: () => cargoExample('bench_ldlt', [], 'bumpy grid'), enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'import', run: wasmNodeImport, enabled: true },
+  { env: 'wasm-node', stage: 'cones', run: wasmNodeCones, enabled: true },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
+  { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },
 ];
 
 // ---------------------------------------------------------------- main

@@ -22,7 +22,7 @@ test('fandisk with sharp features: Gauss-Bonnet, progress by round, exact constr
     stages.add(stage);
     if (stage === 'rounding') roundingCalls += 1;
   });
-  assert.deepEqual([...stages].sort(), ['cone moves', 'rounding', 'topology']);
+  for (const stage of ['topology', 'rounding', 'cone moves']) assert.ok(stages.has(stage), `no ${stage} report`);
   assert.equal(r.feature_edges, sharp.length);
   assert.equal(sumK(r), 4 * 2, 'sum of k = 4 chi');
   for (const c of r.components) {

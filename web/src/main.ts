@@ -1,11 +1,13 @@
-// Page entry: wires the file inputs, the samples menu, the worker and the viewer.
+// Page entry: wires the file inputs, the samples menu, the worker and the viewer;
+// the feature editor and the solve controls live in editor.ts.
+import { Editor, type EditorHooks } from './editor';
 import { fetchFile, orderFiles, readFiles } from './files';
 import { Panels, type Sample, type Stats, fmtBytes } from './panels';
 import type { Stage, WireFile } from './protocol';
 import { Viewer } from './viewer';
 import { MeshWorker } from './worker-client';
 
-type State = 'idle' | 'loading' | 'ready' | 'error';
+type State = 'idle' | 'loading' | 'ready' | 'error' | 'solving' | 'solved';
 
 /** Test hooks (read by tests/e2e and scripts/bench.mjs). */
 interface Hooks {
@@ -18,23 +20,65 @@ interface Hooks {
   loads: number;
   /** Milliseconds of the last load's phases on the main thread's clock. */
   timings: { read: number; worker: number; draw: number } | null;
+  /** Marked feature edges (without the fixed boundary edges). */
+  features: number;
+  /** Figures of the last finished solve (null before one, or after a new mesh). */
+  result: ResultHook | null;
+  /** Message of the last failed solve (null after a successful one). */
+  solveError: string | null;
+  /** Increments on every finished solve (success, failure or cancel). */
+  solves: number;
+  /** Face highlighted in the 3D and UV views (hover sync), or null. */
+  hoverFace: number | null;
+}
+export interface ResultHook {
+  cones: number;
+  plus: number;
+  minus: number;
+  /** Σk over cones and over boundary corners. */
+  sumConeK: number;
+  sumCornerK: number;
+  boundaryCorners: number;
+  /** χ of the whole mesh (from the import report). */
+  eulerCharacteristic: number;
+  rounds: number;
+  featureEdges: number;
+  /** The cone count as shown in the results panel. */
+  shownCones: string;
+  uv: boolean;
+  seams: number;
+  simulated: boolean;
 }
 declare global {
   interface Window {
     __conemap: Hooks;
     /** Test-only actions (tests/e2e). */
-    __conemapTest: { importWithTrap(name: string, text: string): void };
+    __conemapTest: {
+      importWithTrap(name: string, text: string): void;
+      /** Page position of the midpoint of edge `edgeId` (client CSS px). */
+      projectEdge(edgeId: number): { x: number; y: number } | null;
+      /** An interior, unmarked edge whose midpoint is visible and picks back to itself; -1 if none. */
+      visibleEdge(): number;
+      /** Edge id a click at (x, y) would toggle; -1 when none. */
+      edgeAt(x: number, y: number): number;
+      /** Later runs add stand-in UVs (fake-uv.ts) when the build has no `solve`, to exercise the UV display. */
+      simulateUv(on: boolean): void;
+    };
   }
 }
 
 const DEFAULT_SAMPLE = 'fandisk.obj';
-const hooks: Hooks = { state: 'idle', stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null };
+const hooks: Hooks = {
+  state: 'idle', stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
+  features: 0, result: null, solveError: null, solves: 0, hoverFace: null,
+};
 window.__conemap = hooks;
 document.body.dataset['state'] = hooks.state;
 
 const panels = new Panels();
 const viewer = new Viewer(document.getElementById('viewport')!);
 const worker = new MeshWorker();
+const editor = new Editor(viewer, worker, hooks as unknown as EditorHooks, setState);
 
 const stageText: Record<Stage, string> = {
   starting: 'Starting the importer',
@@ -58,6 +102,7 @@ async function load(
 ): Promise<void> {
   const token = ++current;
   const live = (): boolean => token === current;
+  editor.cancelSolve(); // a new mesh supersedes a running solve
   setState('loading');
   panels.clearError();
   panels.setStatus(`Reading ${label}…`, true, 0);
@@ -76,6 +121,7 @@ async function load(
     const tDraw = performance.now();
     panels.setStatus(`Drawing ${label}…`, true);
     viewer.show(result);
+    editor.setMesh(result, label);
     viewer.renderNow();
     hooks.timings = { read: t0 - tRead, worker: tDraw - t0, draw: performance.now() - tDraw };
     const stats: Stats = {
@@ -181,6 +227,12 @@ document.getElementById('frame-button')!.addEventListener('click', () => viewer.
 window.__conemapTest = {
   importWithTrap(name, text) {
     void load(name, async () => [{ name, bytes: new TextEncoder().encode(text).buffer as ArrayBuffer }], true);
+  },
+  projectEdge: (e) => editor.projectEdge(e),
+  visibleEdge: () => editor.visibleEdge(),
+  edgeAt: (x, y) => editor.edgeAt(x, y),
+  simulateUv: (on) => {
+    editor.simulateUv = on;
   },
 };
 

@@ -35,6 +35,20 @@ function genusText(r: MeshReport): string {
   return shown.join(', ') + (r.genus.length > shown.length ? ', …' : '');
 }
 
+/** A two-column table of figures; each value carries `data-stat` (its key in kebab case). */
+export function definitionList(rows: Array<[string, string]>): HTMLDListElement {
+  const table = document.createElement('dl');
+  for (const [k, v] of rows) {
+    const dt = document.createElement('dt');
+    dt.textContent = k;
+    const dd = document.createElement('dd');
+    dd.textContent = v;
+    dd.dataset['stat'] = k.toLowerCase().replace(/[^a-z0-9]+/g, '-').replace(/^-|-$/g, '');
+    table.append(dt, dd);
+  }
+  return table;
+}
+
 export class Panels {
   private readonly status = $('status');
   private readonly statusText = $('status-text');
@@ -98,16 +112,7 @@ export class Panels {
       for (const [k, v] of optional) if (typeof v === 'number') rows.push([k, fmtInt(v)]);
     }
     rows.push(['Import time', `${s.importMs.toFixed(0)} ms`]);
-    const table = document.createElement('dl');
-    for (const [k, v] of rows) {
-      const dt = document.createElement('dt');
-      dt.textContent = k;
-      const dd = document.createElement('dd');
-      dd.textContent = v;
-      dd.dataset['stat'] = k.toLowerCase().replace(/\s+/g, '-');
-      table.append(dt, dd);
-    }
-    this.stats.replaceChildren(table);
+    this.stats.replaceChildren(definitionList(rows));
     this.showProblems(r);
   }
 

@@ -1,6 +1,7 @@
 // Messages between the page and the wasm worker. Every request carries an id;
 // the worker answers with any number of `progress` messages, then exactly one
-// `result` or `error` with the same id.
+// `result` or `error` with the same id. The worker keeps one `MeshSession`
+// (the last mesh opened); later requests (`sharp`, `solve`) refer to it.
 
 /** One input file: the mesh first, companion files (.bin, textures) after it. */
 export interface WireFile {
@@ -8,13 +9,26 @@ export interface WireFile {
   bytes: ArrayBuffer;
 }
 
-export type Request = {
-  id: number;
-  type: 'import';
-  files: WireFile[];
-  /** Test hook: behave as if the wasm trapped (a Rust panic) during this import. */
-  simulateTrap?: boolean;
-};
+export type Request =
+  | {
+      id: number;
+      type: 'import';
+      files: WireFile[];
+      /** Re-open only (after a worker replacement): keep the session, send no geometry back. */
+      quiet?: boolean;
+      /** Test hook: behave as if the wasm trapped (a Rust panic) during this import. */
+      simulateTrap?: boolean;
+    }
+  | { id: number; type: 'sharp'; degrees: number }
+  | {
+      id: number;
+      type: 'solve';
+      features: Uint32Array;
+      alphaSmooth: number;
+      miq: boolean;
+      /** Test hook: add stand-in UVs (fake-uv.ts) when the build has no `solve`. */
+      simulateUv?: boolean;
+    };
 
 export type Stage = 'starting' | 'parsing' | 'analysing' | 'transferring';
 
@@ -40,17 +54,86 @@ export interface MeshReport {
 export interface ImportResult {
   positions: Float32Array;
   indices: Uint32Array;
-  /** Unique edges as vertex-index pairs for the wireframe overlay; null when skipped (huge meshes). */
+  /** Edges as vertex-index pairs (edge id = index / 2: the library's ids when `valid`); null when skipped (huge meshes). */
   edges: Uint32Array | null;
   report: MeshReport | null;
+  /** The mesh can be parametrized (no blocking problem): feature edges and solving are available. */
+  valid: boolean;
+  /** Boundary edge ids (valid meshes). */
+  boundary: Uint32Array;
+  /** Per face the ids of its 3 sides (3f+k: corner k → k+1), for picking; empty for invalid meshes. */
+  faceEdges: Uint32Array;
+  /** Vertex adjacency in CSR form (see topology.ts), for shortest edge paths. */
+  adjacency: { offsets: Uint32Array; nbr: Uint32Array; eid: Uint32Array } | null;
+  /** The wasm build has `MeshSession.solve` (UVs); otherwise only cone placement. */
+  canSolve: boolean;
   /** Milliseconds spent in the wasm import and in the edge extraction. */
   timings: { import: number; edges: number };
   version: string;
 }
 
+export interface Cone {
+  vertex: number;
+  k: number;
+  position: [number, number, number];
+}
+
+export interface ComponentResult {
+  euler_characteristic: number;
+  boundary_loops: number;
+  genus: number;
+  k_sum: number;
+  path_integers?: number[];
+  h?: number[];
+  rounds: number;
+  moves: number;
+  residual: number;
+  [key: string]: unknown;
+}
+
+export interface SolveMetrics {
+  distortion: number;
+  below_0_2: number;
+  below_0_3: number;
+  flipped: number;
+  seam_angle_residual: number;
+  seam_length_residual: number;
+  alignment_residual: number;
+  cones: number;
+  seam_length: number;
+  per_face_distortion?: Float32Array;
+  [key: string]: unknown;
+}
+
+/** Cone placement result (`place_cones`), plus the UV part when the build can `solve`. */
+export interface SolveResult {
+  cones: Cone[];
+  boundary_corners: Cone[];
+  components: ComponentResult[];
+  rounds: number;
+  energy: number;
+  phi_rms: number;
+  timings: Record<string, number>;
+  feature_edges: number;
+  /** Milliseconds in the worker for the whole request. */
+  elapsed: number;
+  uv?: Float32Array;
+  seam_edges?: Uint32Array;
+  metrics?: SolveMetrics;
+  /** The UVs are the test stand-in (fake-uv.ts), not a parametrization. */
+  simulated?: boolean;
+  /** Exports, produced in the worker right after the solve. */
+  glb?: Uint8Array;
+  obj?: string;
+}
+
+export interface SharpResult {
+  edges: Uint32Array;
+}
+
 export type Response =
-  | { id: number; type: 'progress'; stage: Stage }
-  | ({ id: number; type: 'result' } & ImportResult)
+  | { id: number; type: 'progress'; stage: string; step?: number; remaining?: number }
+  | { id: number; type: 'result'; value: unknown }
   | {
       id: number;
       type: 'error';

@@ -1,7 +1,13 @@
-// The three.js view: one mesh with flat shading, an optional edge overlay,
-// orbit controls, camera framed to the mesh. Renders on demand, not in a loop.
+// The three.js view: the mesh (flat shaded, or textured with a checkerboard or a
+// distortion heat map through the UVs), an optional edge overlay, feature /
+// boundary / seam lines drawn thick on top, cones and boundary corners, picking
+// of edges and vertices. Renders on demand, not in a loop.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
+import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
+import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
+import type { Cone } from './protocol';
 
 export interface MeshData {
   positions: Float32Array;
@@ -9,16 +15,103 @@ export interface MeshData {
   edges: Uint32Array | null;
 }
 
+export type SurfaceMode = 'shaded' | 'checker' | 'distortion';
+
+export const COLORS = {
+  feature: 0xff9f1c,
+  boundary: 0x2ec4b6,
+  seam: 0xff4fa3,
+  conePlus: 0xe63946, // k = +1 (angle deficit)
+  coneMinus: 0x3a86ff, // k = −1 (angle excess)
+  coneOther: 0xffd60a, // |k| > 1
+  corner: 0xf1f1f1,
+  anchor: 0xffffff,
+  hover: 0xfff275,
+};
+
+export function coneColor(k: number): number {
+  return k === 1 ? COLORS.conePlus : k === -1 ? COLORS.coneMinus : COLORS.coneOther;
+}
+
+/** Distortion colour ramp (0 = none … 1 = strong): blue → white → red. */
+export function heat(t: number, out: THREE.Color = new THREE.Color()): THREE.Color {
+  const x = Math.max(0, Math.min(1, t));
+  if (x < 0.5) {
+    const y = x * 2;
+    return out.setRGB(0.23 + 0.72 * y, 0.45 + 0.5 * y, 0.95);
+  }
+  const y = (x - 0.5) * 2;
+  return out.setRGB(0.95 - 0.05 * y, 0.95 - 0.75 * y, 0.95 - 0.75 * y);
+}
+
+/** An 8 × 8 checkerboard, repeating. */
+export function checkerTexture(): THREE.Texture {
+  const size = 256;
+  const c = document.createElement('canvas');
+  c.width = c.height = size;
+  const g = c.getContext('2d')!;
+  const n = 8;
+  const s = size / n;
+  for (let i = 0; i < n; i++) {
+    for (let j = 0; j < n; j++) {
+      g.fillStyle = (i + j) % 2 ? '#f4f1ea' : '#3d4f73';
+      g.fillRect(i * s, j * s, s, s);
+    }
+  }
+  const t = new THREE.CanvasTexture(c);
+  t.wrapS = t.wrapT = THREE.RepeatWrapping;
+  t.colorSpace = THREE.SRGBColorSpace;
+  t.anisotropy = 4;
+  return t;
+}
+
+/** UVs scaled for the checker texture: 20 squares across the layout's larger side. */
+export function checkerUv(uv: Float32Array): Float32Array {
+  const scaled = new Float32Array(uv.length);
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (const x of uv) {
+    if (x < lo) lo = x;
+    if (x > hi) hi = x;
+  }
+  const scale = hi > lo ? 2.5 / (hi - lo) : 1;
+  for (let i = 0; i < uv.length; i++) scaled[i] = uv[i]! * scale;
+  return scaled;
+}
+
+export interface Pick {
+  face: number;
+  /** Nearest of the face's 3 sides in screen space (0..2) and its distance in CSS px. */
+  side: number;
+  sideDistance: number;
+  /** Nearest of the face's 3 corners (vertex id) and its distance in CSS px. */
+  vertex: number;
+  vertexDistance: number;
+  point: THREE.Vector3;
+}
+
 export class Viewer {
   private readonly renderer: THREE.WebGLRenderer;
   private readonly scene = new THREE.Scene();
-  private readonly camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
+  readonly camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
   private readonly controls: OrbitControls;
   private readonly group = new THREE.Group();
   private mesh: THREE.Mesh | null = null;
+  private data: MeshData | null = null;
   private wire: THREE.LineSegments | null = null;
   private wireVisible = true;
   private frameRequested = false;
+  private readonly lines = new Map<string, LineSegments2>();
+  private readonly lineMaterials: LineMaterial[] = [];
+  private markers = new THREE.Group();
+  private anchor: THREE.Mesh | null = null;
+  private hover: THREE.Mesh | null = null;
+  private uvMesh: THREE.Mesh | null = null;
+  private mode: SurfaceMode = 'shaded';
+  private checker: THREE.Texture | null = null;
+  private readonly raycaster = new THREE.Raycaster();
+  /** Called after every render (the UV view follows the hover state). */
+  onRender: (() => void) | null = null;
 
   constructor(private readonly container: HTMLElement) {
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -32,6 +125,7 @@ export class Viewer {
     key.position.set(0.6, 1, 1.2);
     this.camera.add(key); // the key light follows the view
     this.scene.add(this.camera, this.group);
+    this.group.add(this.markers);
 
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.addEventListener('change', () => this.requestRender());
@@ -40,29 +134,30 @@ export class Viewer {
     this.resize();
   }
 
+  get canvas(): HTMLCanvasElement {
+    return this.renderer.domElement;
+  }
+
   get hasMesh(): boolean {
     return this.mesh !== null;
+  }
+
+  /** Bounding-sphere radius of the mesh (1 when none). */
+  get radius(): number {
+    return this.mesh?.geometry.boundingSphere?.radius || 1;
   }
 
   /** Replaces the shown mesh and frames the camera to it. */
   show(data: MeshData): void {
     this.clear();
+    this.data = data;
     const geometry = new THREE.BufferGeometry();
     const position = new THREE.BufferAttribute(data.positions, 3);
     geometry.setAttribute('position', position);
     geometry.setIndex(new THREE.BufferAttribute(data.indices, 1));
     geometry.computeBoundingSphere();
-    const material = new THREE.MeshStandardMaterial({
-      color: 0xc9d2de,
-      roughness: 0.75,
-      metalness: 0.05,
-      flatShading: true,
-      side: THREE.DoubleSide,
-      polygonOffset: true, // push faces back so the edge overlay is not z-fighting
-      polygonOffsetFactor: 1,
-      polygonOffsetUnits: 1,
-    });
-    this.mesh = new THREE.Mesh(geometry, material);
+    geometry.computeBoundingBox();
+    this.mesh = new THREE.Mesh(geometry, this.surfaceMaterial());
     this.group.add(this.mesh);
 
     if (data.edges) {
@@ -78,6 +173,74 @@ export class Viewer {
     this.frame();
   }
 
+  private surfaceMaterial(): THREE.Material {
+    const common = {
+      side: THREE.DoubleSide,
+      // Push faces back so the edge overlay and the feature lines are not z-fighting.
+      polygonOffset: true,
+      polygonOffsetFactor: 3,
+      polygonOffsetUnits: 3,
+    };
+    if (this.mode === 'checker' && this.uvMesh) {
+      this.checker ??= checkerTexture();
+      return new THREE.MeshStandardMaterial({ ...common, map: this.checker, roughness: 0.8, metalness: 0, flatShading: true });
+    }
+    if (this.mode === 'distortion' && this.uvMesh?.geometry.getAttribute('color')) {
+      return new THREE.MeshStandardMaterial({ ...common, vertexColors: true, roughness: 0.85, metalness: 0, flatShading: true });
+    }
+    return new THREE.MeshStandardMaterial({ ...common, color: 0xc9d2de, roughness: 0.75, metalness: 0.05, flatShading: true });
+  }
+
+  /**
+   * UV results: a face-corner geometry (positions per corner) carrying `uv` and,
+   * when given, per-face distortion colours (`colors`, rgb per corner). Null
+   * goes back to the plain mesh.
+   */
+  setUvSurface(uv: Float32Array | null, colors: Float32Array | null): void {
+    if (this.uvMesh) {
+      this.group.remove(this.uvMesh);
+      this.uvMesh.geometry.dispose();
+      (this.uvMesh.material as THREE.Material).dispose();
+      this.uvMesh = null;
+    }
+    if (this.mesh) this.mesh.visible = true;
+    if (uv && this.data && this.mesh) {
+      const { positions, indices } = this.data;
+      const corner = new Float32Array(indices.length * 3);
+      for (let c = 0; c < indices.length; c++) {
+        const v = indices[c]!;
+        corner[3 * c] = positions[3 * v]!;
+        corner[3 * c + 1] = positions[3 * v + 1]!;
+        corner[3 * c + 2] = positions[3 * v + 2]!;
+      }
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(corner, 3));
+      g.setAttribute('uv', new THREE.BufferAttribute(checkerUv(uv), 2));
+      if (colors) g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
+      g.boundingSphere = this.mesh.geometry.boundingSphere;
+      this.uvMesh = new THREE.Mesh(g, new THREE.MeshBasicMaterial());
+      this.group.add(this.uvMesh);
+    }
+    this.applyMode();
+  }
+
+  setSurfaceMode(mode: SurfaceMode): void {
+    this.mode = mode;
+    this.applyMode();
+  }
+
+  private applyMode(): void {
+    if (!this.mesh) return;
+    const textured = this.mode !== 'shaded' && this.uvMesh !== null;
+    if (this.uvMesh) {
+      (this.uvMesh.material as THREE.Material).dispose();
+      this.uvMesh.material = this.surfaceMaterial();
+      this.uvMesh.visible = textured;
+    }
+    this.mesh.visible = !textured;
+    this.requestRender();
+  }
+
   get wireframeAvailable(): boolean {
     return this.wire !== null;
   }
@@ -86,6 +249,173 @@ export class Viewer {
     this.wireVisible = visible;
     if (this.wire) this.wire.visible = visible;
     this.requestRender();
+  }
+
+  /**
+   * Draws `edgeIds` of `edges` as thick lines (a named layer: 'features',
+   * 'boundary', 'seams'); an empty list hides the layer.
+   */
+  setLines(name: string, edges: Uint32Array, edgeIds: ArrayLike<number>, color: number, width = 3, order = 0): void {
+    const old = this.lines.get(name);
+    if (old) {
+      this.group.remove(old);
+      old.geometry.dispose();
+      this.lines.delete(name);
+    }
+    if (!this.data || edgeIds.length === 0) {
+      this.requestRender();
+      return;
+    }
+    const p = this.data.positions;
+    const seg = new Float32Array(edgeIds.length * 6);
+    for (let i = 0; i < edgeIds.length; i++) {
+      const e = edgeIds[i]!;
+      const a = edges[2 * e]!;
+      const b = edges[2 * e + 1]!;
+      seg.set(p.subarray(3 * a, 3 * a + 3), 6 * i);
+      seg.set(p.subarray(3 * b, 3 * b + 3), 6 * i + 3);
+    }
+    const g = new LineSegmentsGeometry();
+    g.setPositions(seg);
+    let material = this.lineMaterials.find((m) => m.userData['name'] === name);
+    if (!material) {
+      // Depth-tested against the (offset-back) surface, and pulled forward a little
+      // themselves, so the lines sit on top of the faces they lie on but hide behind the mesh.
+      material = new LineMaterial({
+        color, linewidth: width, worldUnits: false, depthTest: true,
+        polygonOffset: true, polygonOffsetFactor: -2, polygonOffsetUnits: -6,
+      });
+      material.userData['name'] = name;
+      material.resolution.set(this.container.clientWidth || 1, this.container.clientHeight || 1);
+      this.lineMaterials.push(material);
+    }
+    material.color.setHex(color);
+    material.linewidth = width;
+    const lines = new LineSegments2(g, material);
+    lines.renderOrder = 2 + order;
+    this.lines.set(name, lines);
+    this.group.add(lines);
+    this.requestRender();
+  }
+
+  /** Cones as spheres coloured by index; boundary corners as small cubes. */
+  setCones(cones: Cone[], corners: Cone[]): void {
+    for (const child of [...this.markers.children]) {
+      this.markers.remove(child);
+      const m = child as THREE.InstancedMesh;
+      m.geometry.dispose();
+      (m.material as THREE.Material).dispose();
+    }
+    const box = this.mesh?.geometry.boundingBox;
+    const diagonal = box ? box.max.distanceTo(box.min) : 1;
+    const r = diagonal * 0.01;
+    const place = (list: Cone[], geometry: THREE.BufferGeometry, colorOf: (c: Cone) => number): void => {
+      if (list.length === 0) return;
+      const material = new THREE.MeshStandardMaterial({ roughness: 0.35, metalness: 0.1 });
+      const im = new THREE.InstancedMesh(geometry, material, list.length);
+      const m = new THREE.Matrix4();
+      const color = new THREE.Color();
+      list.forEach((c, i) => {
+        m.makeTranslation(c.position[0], c.position[1], c.position[2]);
+        im.setMatrixAt(i, m);
+        im.setColorAt(i, color.setHex(colorOf(c)));
+      });
+      im.renderOrder = 5;
+      this.markers.add(im);
+    };
+    place(cones, new THREE.SphereGeometry(r, 20, 14), (c) => coneColor(c.k));
+    place(corners, new THREE.BoxGeometry(r * 1.7, r * 1.7, r * 1.7), () => COLORS.corner);
+    this.requestRender();
+  }
+
+  /** Marks the first vertex of a Shift-click path (null removes the marker). */
+  setAnchor(vertex: number | null): void {
+    if (this.anchor) {
+      this.group.remove(this.anchor);
+      this.anchor.geometry.dispose();
+      this.anchor = null;
+    }
+    if (vertex !== null && this.data) {
+      const box = this.mesh?.geometry.boundingBox;
+      const r = (box ? box.max.distanceTo(box.min) : 1) * 0.006;
+      this.anchor = new THREE.Mesh(new THREE.SphereGeometry(r, 16, 12), new THREE.MeshBasicMaterial({ color: COLORS.anchor, depthTest: false }));
+      const p = this.data.positions;
+      this.anchor.position.set(p[3 * vertex]!, p[3 * vertex + 1]!, p[3 * vertex + 2]!);
+      this.anchor.renderOrder = 10;
+      this.group.add(this.anchor);
+    }
+    this.requestRender();
+  }
+
+  /** Highlights one face (hover sync with the UV view); null removes it. */
+  setHoverFace(face: number | null): void {
+    if (face === null || !this.data) {
+      if (this.hover) this.hover.visible = false;
+      this.requestRender();
+      return;
+    }
+    if (!this.hover) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3));
+      this.hover = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ color: COLORS.hover, side: THREE.DoubleSide, depthTest: false, transparent: true, opacity: 0.85 }));
+      this.hover.renderOrder = 9;
+      this.group.add(this.hover);
+    }
+    const attr = this.hover.geometry.getAttribute('position') as THREE.BufferAttribute;
+    const { positions, indices } = this.data;
+    for (let k = 0; k < 3; k++) {
+      const v = indices[3 * face + k]!;
+      attr.setXYZ(k, positions[3 * v]!, positions[3 * v + 1]!, positions[3 * v + 2]!);
+    }
+    attr.needsUpdate = true;
+    this.hover.geometry.computeBoundingSphere();
+    this.hover.visible = true;
+    this.requestRender();
+  }
+
+  /** Position of a mesh vertex on the page (CSS px, client coordinates); null when behind the camera. */
+  projectPoint(x: number, y: number, z: number): { x: number; y: number } | null {
+    const v = new THREE.Vector3(x, y, z).applyMatrix4(this.group.matrixWorld).project(this.camera);
+    if (v.z > 1 || v.z < -1) return null;
+    const rect = this.canvas.getBoundingClientRect();
+    return { x: rect.left + ((v.x + 1) / 2) * rect.width, y: rect.top + ((1 - v.y) / 2) * rect.height };
+  }
+
+  /** Picks the face under a page position and its nearest side and corner in screen space. */
+  pick(clientX: number, clientY: number): Pick | null {
+    if (!this.mesh || !this.data) return null;
+    const rect = this.canvas.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+    this.raycaster.setFromCamera(ndc, this.camera);
+    // A plain raycast tests every triangle (no BVH): a few ms per 100k faces, only on clicks.
+    const hit = this.raycaster.intersectObject(this.mesh, false)[0];
+    if (!hit || hit.faceIndex === undefined || hit.faceIndex === null) return null;
+    const face = hit.faceIndex;
+    const { positions, indices } = this.data;
+    const screen: Array<{ x: number; y: number }> = [];
+    for (let k = 0; k < 3; k++) {
+      const v = indices[3 * face + k]!;
+      screen.push(this.projectPoint(positions[3 * v]!, positions[3 * v + 1]!, positions[3 * v + 2]!) ?? { x: Infinity, y: Infinity });
+    }
+    let side = 0;
+    let sideDistance = Infinity;
+    let vertex = indices[3 * face]!;
+    let vertexDistance = Infinity;
+    for (let k = 0; k < 3; k++) {
+      const a = screen[k]!;
+      const b = screen[(k + 1) % 3]!;
+      const d = segmentDistance(clientX, clientY, a.x, a.y, b.x, b.y);
+      if (d < sideDistance) {
+        sideDistance = d;
+        side = k;
+      }
+      const dv = Math.hypot(clientX - a.x, clientY - a.y);
+      if (dv < vertexDistance) {
+        vertexDistance = dv;
+        vertex = indices[3 * face + k]!;
+      }
+    }
+    return { face, side, sideDistance, vertex, vertexDistance, point: hit.point };
   }
 
   /** Points the camera at the mesh's bounding sphere. */
@@ -109,6 +439,11 @@ export class Viewer {
   }
 
   private clear(): void {
+    this.setUvSurface(null, null);
+    for (const name of [...this.lines.keys()]) this.setLines(name, new Uint32Array(0), [], 0);
+    this.setCones([], []);
+    this.setAnchor(null);
+    this.setHoverFace(null);
     for (const obj of [this.mesh, this.wire]) {
       if (!obj) continue;
       this.group.remove(obj);
@@ -118,6 +453,7 @@ export class Viewer {
     this.wire?.geometry.dispose();
     this.mesh = null;
     this.wire = null;
+    this.data = null;
   }
 
   private resize(): void {
@@ -128,6 +464,7 @@ export class Viewer {
     this.renderer.domElement.style.height = '100%';
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
+    for (const m of this.lineMaterials) m.resolution.set(w, h);
     this.requestRender();
   }
 
@@ -136,12 +473,21 @@ export class Viewer {
     this.frameRequested = true;
     requestAnimationFrame(() => {
       this.frameRequested = false;
-      this.renderer.render(this.scene, this.camera);
+      this.renderNow();
     });
   }
 
   /** Renders now (used before screenshots and after loading, so "ready" means drawn). */
   renderNow(): void {
     this.renderer.render(this.scene, this.camera);
+    this.onRender?.();
   }
+}
+
+function segmentDistance(px: number, py: number, ax: number, ay: number, bx: number, by: number): number {
+  const dx = bx - ax;
+  const dy = by - ay;
+  const len2 = dx * dx + dy * dy;
+  const t = len2 > 0 ? Math.max(0, Math.min(1, ((px - ax) * dx + (py - ay) * dy) / len2)) : 0;
+  return Math.hypot(px - (ax + t * dx), py - (ay + t * dy));
 }

@@ -1,8 +1,12 @@
 // Module Web Worker: the only place the wasm runs. Receives `Request`s, answers
 // with `Response`s (see protocol.ts); result buffers are transferred, not copied.
-import init, { import_mesh, version } from '@conemap/wasm';
+// Keeps the last opened mesh as a `MeshSession` so that sharp-edge queries and
+// solves do not re-import it.
+import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { MeshReport, Request, Response } from './protocol';
+import type { ImportResult, MeshReport, Request, Response, SolveResult } from './protocol';
+import { fakeUv } from './fake-uv';
+import { buildAdjacency, faceEdges } from './topology';
 
 interface WorkerScope {
   onmessage: ((event: MessageEvent<Request>) => void) | null;
@@ -14,6 +18,24 @@ let ready: Promise<unknown> | null = null;
 const wasmReady = (): Promise<unknown> =>
   (ready ??= init({ module_or_path: new URL('./pkg/conemap_bg.wasm', import.meta.url) }));
 
+/** The session API as the page uses it; `solve` only exists in newer builds. */
+type Progress = (stage: string, step: number, remaining: number) => void;
+interface Session {
+  report(): MeshReport;
+  is_valid(): boolean;
+  positions(): Float32Array;
+  indices(): Uint32Array;
+  edges(): Uint32Array;
+  boundary_edges(): Uint32Array;
+  sharp_edges(degrees: number): Uint32Array;
+  place_cones(features: Uint32Array, alpha: number, miq: boolean, progress: Progress): Omit<SolveResult, 'elapsed'>;
+  solve?: (features: Uint32Array, alpha: number, miq: boolean, progress: Progress) => unknown;
+  free(): void;
+}
+let session: Session | null = null;
+/** Geometry of the open session, for the test stand-in UVs. */
+let geometry: { positions: Float32Array; indices: Uint32Array; faceEdges: Uint32Array; edgeCount: number } | null = null;
+
 function post(message: Response, transfer: Transferable[] = []): void {
   scope.postMessage(message, transfer);
 }
@@ -21,6 +43,124 @@ function post(message: Response, transfer: Transferable[] = []): void {
 function errorMessage(e: unknown): string {
   if (e instanceof Error) return e.message || e.name;
   return String(e);
+}
+
+function openMesh(req: Extract<Request, { type: 'import' }>): { value: unknown; transfer: Transferable[] } {
+  const { id } = req;
+  post({ id, type: 'progress', stage: 'parsing' });
+  const files = req.files.map((f) => ({ name: f.name, bytes: new Uint8Array(f.bytes) }));
+  const t0 = performance.now();
+  if (req.simulateTrap) throw new WebAssembly.RuntimeError('unreachable (simulated trap)');
+  const next = MeshSession.open(files) as unknown as Session;
+  session?.free();
+  session = next;
+  geometry = null;
+  if (req.quiet) return { value: null, transfer: [] };
+  const positions = next.positions();
+  const indices = next.indices();
+  const report = next.report();
+  const valid = next.is_valid();
+  const t1 = performance.now();
+  post({ id, type: 'progress', stage: 'analysing' });
+  const faces = indices.length / 3;
+  const vertexCount = positions.length / 3;
+  let edges: Uint32Array | null = null;
+  let boundary: Uint32Array = new Uint32Array(0);
+  let faceEdgeIds: Uint32Array = new Uint32Array(0);
+  let adjacency: ImportResult['adjacency'] = null;
+  if (valid) {
+    edges = next.edges();
+    boundary = next.boundary_edges();
+    adjacency = buildAdjacency(edges, vertexCount);
+    faceEdgeIds = faceEdges(indices, adjacency);
+  } else if (faces <= MAX_WIREFRAME_FACES) {
+    edges = uniqueEdges(indices, vertexCount);
+  }
+  const t2 = performance.now();
+  // Only builds without `solve` need the copies (for the test stand-in UVs).
+  if (valid && edges && typeof next.solve !== 'function') geometry = { positions: positions.slice(), indices: indices.slice(), faceEdges: faceEdgeIds.slice(), edgeCount: edges.length / 2 };
+  post({ id, type: 'progress', stage: 'transferring' });
+  const result: ImportResult = {
+    positions,
+    indices,
+    edges,
+    report,
+    valid,
+    boundary,
+    faceEdges: faceEdgeIds,
+    adjacency,
+    canSolve: typeof next.solve === 'function',
+    timings: { import: t1 - t0, edges: t2 - t1 },
+    version: version(),
+  };
+  const transfer: Transferable[] = [positions.buffer, indices.buffer, boundary.buffer, faceEdgeIds.buffer];
+  if (edges) transfer.push(edges.buffer);
+  if (adjacency) transfer.push(adjacency.offsets.buffer, adjacency.nbr.buffer, adjacency.eid.buffer);
+  return { value: result, transfer };
+}
+
+function requireSession(): Session {
+  if (!session) throw new Error('no mesh is open');
+  return session;
+}
+
+function solve(req: Extract<Request, { type: 'solve' }>): { value: unknown; transfer: Transferable[] } {
+  const s = requireSession();
+  const { id } = req;
+  let lastPost = 0;
+  const progress: Progress = (stage, step, remaining) => {
+    // Rounding can call this thousands of times: post at most every 30 ms.
+    const now = performance.now();
+    if (now - lastPost < 30) return;
+    lastPost = now;
+    post({ id, type: 'progress', stage, step, remaining });
+  };
+  const t0 = performance.now();
+  post({ id, type: 'progress', stage: 'starting', step: 0, remaining: 0 });
+  if (typeof s.solve === 'function') {
+    const raw = s.solve(req.features, req.alphaSmooth, req.miq, progress) as Record<string, unknown>;
+    // The result may be a plain object or a wasm-bindgen class (getters / methods on
+    // its prototype): read the known fields and any own ones, calling methods.
+    const keys = new Set([
+      'cones', 'boundary_corners', 'components', 'rounds', 'energy', 'phi_rms', 'timings', 'feature_edges',
+      'uv', 'seam_edges', 'metrics', 'glb', 'obj', ...Object.keys(raw),
+    ]);
+    const out: Record<string, unknown> = {};
+    for (const key of keys) {
+      if (key.startsWith('__') || key === 'free') continue;
+      let v: unknown;
+      try {
+        v = raw[key];
+        if (typeof v === 'function') v = (v as () => unknown).call(raw);
+      } catch (e) {
+        console.warn(`conemap: reading ${key} of the solve result failed: ${errorMessage(e)}`);
+        continue;
+      }
+      if (v !== undefined && typeof v !== 'function') out[key] = v;
+    }
+    if (typeof raw['free'] === 'function') (raw['free'] as () => void).call(raw);
+    if (Array.isArray(out['uv'])) out['uv'] = Float32Array.from(out['uv'] as number[]);
+    if (Array.isArray(out['seam_edges'])) out['seam_edges'] = Uint32Array.from(out['seam_edges'] as number[]);
+    const metrics = out['metrics'] as Record<string, unknown> | undefined;
+    if (metrics && Array.isArray(metrics['per_face_distortion'])) {
+      metrics['per_face_distortion'] = Float32Array.from(metrics['per_face_distortion'] as number[]);
+    }
+    const value = { ...(out as unknown as SolveResult), elapsed: performance.now() - t0 };
+    const transfer: Transferable[] = [];
+    for (const v of [value.uv, value.seam_edges, value.glb, value.metrics?.per_face_distortion]) {
+      if (v && ArrayBuffer.isView(v) && v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
+    }
+    return { value, transfer };
+  }
+  const r = s.place_cones(req.features, req.alphaSmooth, req.miq, progress);
+  if (req.simulateUv && geometry) {
+    const g = geometry;
+    const fake = fakeUv(g.positions, g.indices, g.faceEdges, g.edgeCount);
+    fake.metrics.cones = r.cones.length;
+    const value: SolveResult = { ...r, ...fake, simulated: true, elapsed: performance.now() - t0 };
+    return { value, transfer: [fake.uv.buffer, fake.seam_edges.buffer, fake.metrics.per_face_distortion!.buffer] };
+  }
+  return { value: { ...r, elapsed: performance.now() - t0 }, transfer: [] };
 }
 
 async function handle(req: Request): Promise<void> {
@@ -33,40 +173,34 @@ async function handle(req: Request): Promise<void> {
       post({ id, type: 'error', message: `could not load the wasm module: ${errorMessage(e)}`, fatal: true });
       return;
     }
-    post({ id, type: 'progress', stage: 'parsing' });
-    const files = req.files.map((f) => ({ name: f.name, bytes: new Uint8Array(f.bytes) }));
-    const t0 = performance.now();
-    if (req.simulateTrap) throw new WebAssembly.RuntimeError('unreachable (simulated trap)');
-    const out = import_mesh(files) as { positions: Float32Array; indices: Uint32Array; report?: MeshReport };
-    const t1 = performance.now();
-    post({ id, type: 'progress', stage: 'analysing' });
-    const faces = out.indices.length / 3;
-    const edges = faces <= MAX_WIREFRAME_FACES ? uniqueEdges(out.indices, out.positions.length / 3) : null;
-    const t2 = performance.now();
-    post({ id, type: 'progress', stage: 'transferring' });
-    const transfer: Transferable[] = [out.positions.buffer, out.indices.buffer];
-    if (edges) transfer.push(edges.buffer);
-    post(
-      {
-        id,
-        type: 'result',
-        positions: out.positions,
-        indices: out.indices,
-        edges,
-        report: out.report ?? null,
-        timings: { import: t1 - t0, edges: t2 - t1 },
-        version: version(),
-      },
-      transfer,
-    );
+    let out: { value: unknown; transfer: Transferable[] };
+    switch (req.type) {
+      case 'import':
+        out = openMesh(req);
+        break;
+      case 'sharp': {
+        const edges = requireSession().sharp_edges(req.degrees);
+        out = { value: { edges }, transfer: [edges.buffer] };
+        break;
+      }
+      case 'solve':
+        out = solve(req);
+        break;
+    }
+    post({ id, type: 'result', value: out.value }, out.transfer);
   } catch (e) {
     // A trap (a Rust panic ends in `unreachable`) leaves the instance unusable.
     const fatal = e instanceof WebAssembly.RuntimeError;
-    const message = fatal ? `the importer crashed (${errorMessage(e)}); this is a bug in conemap` : errorMessage(e);
+    const what = req.type === 'import' ? 'the importer' : 'the solver';
+    const message = fatal ? `${what} crashed (${errorMessage(e)}); this is a bug in conemap` : errorMessage(e);
+    if (fatal) session = null;
     post({ id, type: 'error', message, fatal });
   }
 }
 
+// Requests run one after the other, in arrival order.
+let queue: Promise<void> = Promise.resolve();
 scope.onmessage = (event) => {
-  void handle(event.data);
+  const req = event.data;
+  queue = queue.then(() => handle(req));
 };

@@ -1,0 +1,650 @@
+// Feature editing (click / Shift-click paths / sharp threshold / undo) and the
+// solve controls (α_smooth, MIQ, Run, Cancel, progress, results, downloads).
+import * as THREE from 'three';
+import { FeatureSet } from './features';
+import { definitionList } from './panels';
+import type { ImportResult, SolveResult } from './protocol';
+import { type Adjacency, shortestPath } from './topology';
+import { UvView } from './uvview';
+import { COLORS, type SurfaceMode, type Viewer, heat } from './viewer';
+import { Cancelled, type MeshWorker } from './worker-client';
+
+export interface EditorHooks {
+  state: string;
+  features: number;
+  result: {
+    cones: number;
+    plus: number;
+    minus: number;
+    sumConeK: number;
+    sumCornerK: number;
+    boundaryCorners: number;
+    eulerCharacteristic: number;
+    rounds: number;
+    featureEdges: number;
+    shownCones: string;
+    uv: boolean;
+    seams: number;
+    simulated: boolean;
+  } | null;
+  solveError: string | null;
+  solves: number;
+  hoverFace: number | null;
+}
+
+const $ = <T extends HTMLElement>(id: string): T => {
+  const el = document.getElementById(id);
+  if (!el) throw new Error(`#${id} missing from index.html`);
+  return el as T;
+};
+
+const NO_EDGE = 0xffffffff;
+/** A click further than this from every side of the hit triangle toggles nothing (CSS px). */
+const PICK_TOLERANCE = 24;
+
+const fmt = (x: number, digits = 3): string =>
+  !Number.isFinite(x) ? '—' : Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(2) : x.toFixed(digits);
+const fmtInt = (n: number): string => n.toLocaleString('en-US');
+const alphaOf = (slider: number): number => 10 ** slider;
+
+interface MeshState {
+  label: string;
+  data: ImportResult;
+  edges: Uint32Array;
+  features: FeatureSet | null;
+  adjacency: Adjacency | null;
+}
+
+export class Editor {
+  private mesh: MeshState | null = null;
+  private anchor: number | null = null;
+  private solving = false;
+  private result: SolveResult | null = null;
+  private resultSettings: Record<string, unknown> | null = null;
+  private uvView: UvView;
+  private roundingStart = 0;
+  private readonly el = {
+    count: $('feature-count'),
+    boundaryCount: $('boundary-count'),
+    sharpToggle: $<HTMLInputElement>('sharp-toggle'),
+    sharpAngle: $<HTMLInputElement>('sharp-angle'),
+    sharpValue: $<HTMLOutputElement>('sharp-value'),
+    undo: $<HTMLButtonElement>('undo-button'),
+    redo: $<HTMLButtonElement>('redo-button'),
+    clear: $<HTMLButtonElement>('clear-features'),
+    alpha: $<HTMLInputElement>('alpha'),
+    alphaValue: $<HTMLOutputElement>('alpha-value'),
+    miq: $<HTMLInputElement>('miq'),
+    run: $<HTMLButtonElement>('run-button'),
+    cancel: $<HTMLButtonElement>('cancel-button'),
+    progress: $('solve-progress'),
+    stage: $('solve-stage'),
+    bar: $<HTMLProgressElement>('solve-bar'),
+    error: $('solve-error'),
+    note: $('solve-note'),
+    status: $('solve-status'),
+    results: $('results'),
+    resultStats: $('result-stats'),
+    distortionLegend: $('distortion-legend'),
+    distortionMax: $('distortion-max'),
+    histogram: $<HTMLCanvasElement>('histogram'),
+    glb: $<HTMLButtonElement>('download-glb'),
+    obj: $<HTMLButtonElement>('download-obj'),
+    json: $<HTMLButtonElement>('download-json'),
+    uv: $('uv-view'),
+    uvFrame: $<HTMLButtonElement>('uv-frame'),
+    simulated: $('simulated-note'),
+  };
+
+  constructor(
+    private readonly viewer: Viewer,
+    private readonly worker: MeshWorker,
+    private readonly hooks: EditorHooks,
+    private readonly setState: (s: 'ready' | 'solving' | 'solved') => void,
+  ) {
+    this.uvView = new UvView(this.el.uv);
+    this.uvView.onHover = (face) => this.hoverSync(face);
+    this.wirePicking();
+    this.wireControls();
+    this.updateFeatureUi();
+  }
+
+  // ---- mesh -------------------------------------------------------------
+
+  setMesh(data: ImportResult, label: string): void {
+    const edges = data.edges ?? new Uint32Array(0);
+    const features = data.valid && data.edges ? new FeatureSet(edges.length / 2, data.boundary) : null;
+    this.mesh = { label, data, edges, features, adjacency: data.adjacency };
+    this.anchor = null;
+    this.el.sharpToggle.checked = false;
+    this.el.sharpAngle.disabled = true;
+    this.clearResult();
+    this.el.error.hidden = true;
+    this.el.status.hidden = true;
+    if (features) this.viewer.setLines('boundary', edges, data.boundary, COLORS.boundary, 3, 0);
+    this.redrawFeatures();
+    this.el.note.hidden = data.canSolve;
+    this.el.note.textContent = data.canSolve ? '' : 'Parametrization not available in this build: Run places the cones only; UV views are disabled.';
+    if (!data.valid) {
+      this.el.note.hidden = false;
+      this.el.note.textContent = 'This mesh has blocking problems (see below): features cannot be marked and Run will report why it cannot be parametrized.';
+    }
+    this.updateFeatureUi();
+  }
+
+  private clearResult(): void {
+    this.result = null;
+    this.resultSettings = null;
+    this.hooks.result = null;
+    this.el.results.hidden = true;
+    this.el.uv.hidden = true;
+    this.uvView.clear();
+    this.viewer.setCones([], []);
+    this.viewer.setLines('seams', this.mesh?.edges ?? new Uint32Array(0), [], COLORS.seam);
+    this.viewer.setUvSurface(null, null);
+    this.viewer.setHoverFace(null);
+  }
+
+  /** Highlights the same face in the 3D view and the UV view. */
+  private hoverSync(face: number | null): void {
+    this.hooks.hoverFace = face;
+    this.viewer.setHoverFace(face);
+    this.uvView.setHoverFace(face);
+  }
+
+  // ---- features ---------------------------------------------------------
+
+  private redrawFeatures(): void {
+    const m = this.mesh;
+    const ids = m?.features?.ids() ?? new Uint32Array(0);
+    this.viewer.setLines('features', m?.edges ?? new Uint32Array(0), ids, COLORS.feature, 3.5, 1);
+    this.updateFeatureUi();
+  }
+
+  private updateFeatureUi(): void {
+    const f = this.mesh?.features ?? null;
+    const n = f?.count ?? 0;
+    this.hooks.features = n;
+    this.el.count.textContent = fmtInt(n);
+    this.el.count.title = `${n} feature edges marked`;
+    this.el.boundaryCount.textContent = f ? `(${fmtInt(f.boundaryCount)})` : '';
+    this.el.undo.disabled = !f?.canUndo;
+    this.el.redo.disabled = !f?.canRedo;
+    this.el.clear.disabled = !f || n === 0;
+    this.el.sharpToggle.disabled = !f;
+    this.el.run.disabled = !this.mesh || this.solving;
+    this.el.cancel.disabled = !this.solving;
+  }
+
+  private changed(did: boolean): void {
+    if (!did) return;
+    this.redrawFeatures();
+    if (this.result && !this.solving) {
+      this.el.status.textContent = 'Features changed since this result: Run again to update it.';
+      this.el.status.hidden = false;
+    }
+  }
+
+  private edgeFromPick(x: number, y: number): number {
+    const m = this.mesh;
+    if (!m?.features) return -1;
+    const pick = this.viewer.pick(x, y);
+    if (!pick || pick.sideDistance > PICK_TOLERANCE) return -1;
+    const e = m.data.faceEdges[3 * pick.face + pick.side]!;
+    return e === NO_EDGE ? -1 : e;
+  }
+
+  private click(x: number, y: number, shift: boolean): void {
+    const m = this.mesh;
+    if (!m?.features) return;
+    if (shift) {
+      const pick = this.viewer.pick(x, y);
+      if (!pick) return;
+      if (this.anchor === null) {
+        this.anchor = pick.vertex;
+        this.viewer.setAnchor(pick.vertex);
+        return;
+      }
+      const path = m.adjacency ? shortestPath(m.adjacency, m.data.positions, this.anchor, pick.vertex) : null;
+      this.anchor = null;
+      this.viewer.setAnchor(null);
+      if (path) this.changed(m.features.addAll(path));
+      return;
+    }
+    const e = this.edgeFromPick(x, y);
+    if (e >= 0) this.changed(m.features.toggle(e));
+  }
+
+  private wirePicking(): void {
+    const canvas = this.viewer.canvas;
+    let down: { x: number; y: number; t: number } | null = null;
+    canvas.addEventListener('pointerdown', (e) => {
+      down = e.button === 0 ? { x: e.clientX, y: e.clientY, t: performance.now() } : null;
+    });
+    canvas.addEventListener('pointerup', (e) => {
+      if (!down || e.button !== 0) return;
+      const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
+      const quick = performance.now() - down.t < 600;
+      down = null;
+      if (moved < 5 && quick) this.click(e.clientX, e.clientY, e.shiftKey);
+    });
+    // Hover sync with the UV view (only while a UV layout is shown).
+    let pending: PointerEvent | null = null;
+    canvas.addEventListener('pointermove', (e) => {
+      if (e.buttons || this.el.uv.hidden) return;
+      if (!pending) {
+        requestAnimationFrame(() => {
+          const ev = pending!;
+          pending = null;
+          this.hoverSync(this.viewer.pick(ev.clientX, ev.clientY)?.face ?? null);
+        });
+      }
+      pending = e;
+    });
+    canvas.addEventListener('pointerleave', () => {
+      if (!this.el.uv.hidden) this.hoverSync(null);
+    });
+  }
+
+  private async applySharp(): Promise<void> {
+    const f = this.mesh?.features;
+    if (!f) return;
+    const mesh = this.mesh;
+    const deg = Number(this.el.sharpAngle.value);
+    if (!this.el.sharpToggle.checked) {
+      this.changed(f.setSharp(null));
+      return;
+    }
+    try {
+      const { edges } = await this.worker.sharpEdges(deg);
+      if (this.mesh !== mesh || !this.el.sharpToggle.checked || Number(this.el.sharpAngle.value) !== deg) return;
+      this.changed(f.setSharp(edges));
+    } catch (e) {
+      if (!(e instanceof Cancelled)) this.showError(`sharp edges: ${e instanceof Error ? e.message : String(e)}`);
+    }
+  }
+
+  private wireControls(): void {
+    const el = this.el;
+    el.sharpToggle.addEventListener('change', () => {
+      el.sharpAngle.disabled = !el.sharpToggle.checked;
+      void this.applySharp();
+    });
+    el.sharpAngle.addEventListener('input', () => (el.sharpValue.textContent = `${el.sharpAngle.value}°`));
+    el.sharpAngle.addEventListener('change', () => void this.applySharp());
+    el.undo.addEventListener('click', () => this.changed(this.mesh?.features?.undo() ?? false));
+    el.redo.addEventListener('click', () => this.changed(this.mesh?.features?.redo() ?? false));
+    el.clear.addEventListener('click', () => {
+      el.sharpToggle.checked = false;
+      el.sharpAngle.disabled = true;
+      this.changed(this.mesh?.features?.clear() ?? false);
+    });
+    window.addEventListener('keydown', (e) => {
+      const target = e.target as HTMLElement | null;
+      if (target && (target.tagName === 'INPUT' && (target as HTMLInputElement).type === 'text')) return;
+      const key = e.key.toLowerCase();
+      if ((e.ctrlKey || e.metaKey) && key === 'z') {
+        e.preventDefault();
+        this.changed((e.shiftKey ? this.mesh?.features?.redo() : this.mesh?.features?.undo()) ?? false);
+      } else if ((e.ctrlKey || e.metaKey) && key === 'y') {
+        e.preventDefault();
+        this.changed(this.mesh?.features?.redo() ?? false);
+      } else if (key === 'escape' && this.anchor !== null) {
+        this.anchor = null;
+        this.viewer.setAnchor(null);
+      }
+    });
+    const showAlpha = (): void => {
+      el.alphaValue.textContent = alphaText(alphaOf(Number(el.alpha.value)));
+    };
+    el.alpha.addEventListener('input', showAlpha);
+    showAlpha();
+    el.run.addEventListener('click', () => void this.run());
+    el.cancel.addEventListener('click', () => this.cancelSolve());
+    for (const radio of document.querySelectorAll<HTMLInputElement>('input[name=surface]')) {
+      radio.addEventListener('change', () => {
+        if (radio.checked) this.setSurface(radio.value as SurfaceMode);
+      });
+    }
+    el.json.addEventListener('click', () => this.downloadJson());
+    el.uvFrame.addEventListener('click', () => this.uvView.frame());
+    el.glb.addEventListener('click', () => {
+      const glb = this.result?.glb;
+      if (glb) download(new Blob([glb as Uint8Array<ArrayBuffer>], { type: 'model/gltf-binary' }), `${this.baseName()}-uv.glb`);
+    });
+    el.obj.addEventListener('click', () => {
+      const obj = this.result?.obj;
+      if (obj) download(new Blob([obj], { type: 'text/plain' }), `${this.baseName()}-uv.obj`);
+    });
+  }
+
+  // ---- solve ------------------------------------------------------------
+
+  private showError(message: string): void {
+    this.el.error.textContent = message;
+    this.el.error.hidden = false;
+  }
+
+  private progressText(stage: string, step = 0, remaining = 0): [string, number | undefined] {
+    switch (stage) {
+      case 'starting':
+        return ['Starting…', undefined];
+      case 'topology':
+        return [`Topology: component ${step + 1} of ${Math.max(remaining, 1)}`, remaining ? (step + 1) / remaining : undefined];
+      case 'rounding': {
+        if (step === 0 || remaining > this.roundingStart) this.roundingStart = remaining;
+        const frac = this.roundingStart ? 1 - remaining / this.roundingStart : undefined;
+        return [`Rounding: round ${step + 1} (${fmtInt(remaining)} remaining)`, frac];
+      }
+      case 'cone moves':
+        return [`Cone moves: pass ${step + 1}`, undefined];
+      case 'cut':
+        return ['Cutting the mesh open', undefined];
+      case 'cross-field':
+        return ['Cross field', undefined];
+      case 'poisson':
+        return ['Poisson solve', undefined];
+      case 'arap':
+      case 'ARAP':
+        return [`ARAP iteration ${step + 1}${remaining ? ` of ${fmtInt(remaining)}` : ''}`, remaining ? step / remaining : undefined];
+      case 'repair':
+        return [`Repairing flipped faces: round ${step + 1} (${fmtInt(remaining)} flipped)`, undefined];
+      case 'pair cancellation':
+        return [`Cancelling cone pairs (${fmtInt(step)} removed)`, undefined];
+      default: {
+        const label = stage.charAt(0).toUpperCase() + stage.slice(1);
+        const of = remaining ? ` (${fmtInt(remaining)} remaining)` : '';
+        return [`${label}: iteration ${step + 1}${of}`, remaining ? step / (step + remaining) : undefined];
+      }
+    }
+  }
+
+  private setProgress(stage: string, step?: number, remaining?: number): void {
+    const [text, frac] = this.progressText(stage, step, remaining);
+    this.el.stage.textContent = text;
+    if (frac === undefined) this.el.bar.removeAttribute('value');
+    else this.el.bar.value = Math.max(0, Math.min(1, frac));
+  }
+
+  /** Test hook: the next runs add stand-in UVs when the build has no `solve` (fake-uv.ts). */
+  simulateUv = false;
+
+  async run(): Promise<void> {
+    const m = this.mesh;
+    if (!m || this.solving) return;
+    const features = m.features?.ids() ?? new Uint32Array(0);
+    const alpha = alphaOf(Number(this.el.alpha.value));
+    const miq = this.el.miq.checked;
+    const settings = {
+      alpha_smooth: alpha,
+      miq,
+      sharp_threshold_degrees: this.el.sharpToggle.checked ? Number(this.el.sharpAngle.value) : null,
+      feature_edges: features.length,
+    };
+    this.solving = true;
+    this.el.status.hidden = true;
+    document.body.dataset['solving'] = 'true';
+    this.el.error.hidden = true;
+    this.el.progress.hidden = false;
+    this.roundingStart = 0;
+    this.setProgress('starting');
+    this.updateFeatureUi();
+    this.setState('solving');
+    const t0 = performance.now();
+    try {
+      const result = await this.worker.solve(features, alpha, miq, (stage, step, remaining) => {
+        if (this.mesh === m) this.setProgress(stage, step, remaining);
+      }, this.simulateUv && !m.data.canSolve);
+      if (this.mesh !== m) return;
+      this.clearResult();
+      this.result = result;
+      this.resultSettings = { ...settings, wall_ms: performance.now() - t0 };
+      this.showResult(m, result);
+      this.hooks.solveError = null;
+      this.setState('solved');
+    } catch (e) {
+      if (this.mesh !== m) return;
+      if (e instanceof Cancelled) {
+        this.setState(this.result ? 'solved' : 'ready');
+      } else {
+        const message = e instanceof Error ? e.message : String(e);
+        this.hooks.solveError = message;
+        this.showError(message);
+        this.setState(this.result ? 'solved' : 'ready');
+      }
+    } finally {
+      if (this.mesh === m) {
+        this.solving = false;
+        delete document.body.dataset['solving'];
+        this.el.progress.hidden = true;
+        this.hooks.solves++;
+        this.updateFeatureUi();
+      }
+    }
+  }
+
+  /** Stops a running solve: the worker is terminated and replaced at once (the mesh is re-opened in the new one). */
+  cancelSolve(): void {
+    if (!this.solving) return;
+    this.worker.cancel();
+    this.el.status.textContent = 'Cancelled; the solver was stopped.';
+    this.el.status.hidden = false;
+    this.solving = false;
+    delete document.body.dataset['solving'];
+    this.el.progress.hidden = true;
+    this.updateFeatureUi();
+  }
+
+  private showResult(m: MeshState, r: SolveResult): void {
+    const plus = r.cones.filter((c) => c.k > 0).length;
+    const minus = r.cones.filter((c) => c.k < 0).length;
+    const sumConeK = r.cones.reduce((s, c) => s + c.k, 0);
+    const sumCornerK = r.boundary_corners.reduce((s, c) => s + c.k, 0);
+    this.viewer.setCones(r.cones, r.boundary_corners);
+    const report = m.data.report;
+    const genus = report?.genus?.length ? report.genus.join(', ') : '—';
+    const coneText = `${fmtInt(r.cones.length)} (+${plus} / −${minus})`;
+    const t = r.timings;
+    const rows: Array<[string, string]> = [
+      ['Vertices', fmtInt(m.data.positions.length / 3)],
+      ['Faces', fmtInt(m.data.indices.length / 3)],
+      ['Genus', genus],
+      ['Boundary loops', report ? fmtInt(report.boundary_loops) : '—'],
+      ['Features', fmtInt(r.feature_edges)],
+      ['Cones', coneText],
+      ['Boundary corners', fmtInt(r.boundary_corners.length)],
+      ['Σk (cones + corners)', `${sumConeK + sumCornerK} = 4χ = ${4 * (report?.euler_characteristic ?? NaN)}`],
+      ['Energy', fmt(r.energy, 4)],
+      ['φ rms', fmt(r.phi_rms, 4)],
+      ['Rounding rounds', fmtInt(r.rounds)],
+    ];
+    const metrics = r.metrics;
+    if (metrics) {
+      rows.push(
+        ['Distortion', fmt(metrics.distortion)],
+        ['Faces < 0.2 / < 0.3', `${fmt(metrics.below_0_2 * 100, 1)} % / ${fmt(metrics.below_0_3 * 100, 1)} %`],
+        ['Flipped faces', fmtInt(metrics.flipped)],
+        ['Seam length', fmt(metrics.seam_length)],
+        ['Seam residual (angle / length)', `${fmt(metrics.seam_angle_residual)} / ${fmt(metrics.seam_length_residual)}`],
+        ['Alignment residual', fmt(metrics.alignment_residual)],
+      );
+    }
+    for (const [k, v] of Object.entries(t)) {
+      if (typeof v === 'number') rows.push([`Time: ${k.replace(/_/g, ' ')}`, `${(v * 1000).toFixed(0)} ms`]);
+    }
+    const pt = (r as { param_timings?: Record<string, unknown> }).param_timings;
+    if (pt) {
+      for (const [k, v] of Object.entries(pt)) {
+        if (typeof v === 'number') rows.push([`Time: ${k.replace(/_/g, ' ')} (UV)`, `${(v * 1000).toFixed(0)} ms`]);
+      }
+    }
+    const splits = (r as { split_edges?: number }).split_edges;
+    if (typeof splits === 'number' && splits > 0) rows.push(['Split edges', fmtInt(splits)]);
+    rows.push(['Time in worker', `${r.elapsed.toFixed(0)} ms`]);
+    const list = definitionList(rows);
+    const coneDd = list.querySelector<HTMLElement>('dd[data-stat=cones]');
+    if (coneDd) coneDd.dataset['testid'] = 'cone-count';
+    this.el.resultStats.replaceChildren(list);
+    this.el.results.hidden = false;
+
+    const hasUv = Boolean(r.uv && r.uv.length === (m.data.indices.length / 3) * 6);
+    for (const radio of document.querySelectorAll<HTMLInputElement>('input[name=surface]')) {
+      radio.disabled = radio.value !== 'shaded' && !hasUv;
+      radio.parentElement!.title = radio.disabled ? 'parametrization not available in this build' : '';
+      if (radio.value === 'shaded') radio.checked = !hasUv;
+      if (radio.value === 'checker') radio.checked = hasUv;
+    }
+    this.el.glb.disabled = !r.glb;
+    this.el.obj.disabled = !r.obj;
+    this.el.json.disabled = false;
+    this.el.distortionLegend.hidden = true;
+    this.el.simulated.hidden = !r.simulated;
+    if (hasUv && r.uv) {
+      const perFace = metrics?.per_face_distortion;
+      const colors = perFace ? this.distortionColors(perFace) : null;
+      this.viewer.setUvSurface(r.uv, colors);
+      if (r.seam_edges) this.viewer.setLines('seams', m.edges, r.seam_edges, COLORS.seam, 2.5, 2);
+      this.el.uv.hidden = false;
+      // Chart outlines in the UV view: face sides on a seam or on the boundary.
+      const cut = new Uint8Array(m.edges.length / 2);
+      for (const e of r.seam_edges ?? []) cut[e] = 1;
+      for (const e of m.data.boundary) cut[e] = 1;
+      const sides: number[] = [];
+      const fe = m.data.faceEdges;
+      for (let i = 0; i < fe.length; i++) if (fe[i]! < cut.length && cut[fe[i]!]) sides.push(i);
+      this.uvView.show(r.uv, colors, Uint32Array.from(sides));
+      this.setSurface('checker');
+    } else {
+      this.viewer.setSurfaceMode('shaded');
+    }
+    this.hooks.result = {
+      cones: r.cones.length,
+      plus,
+      minus,
+      sumConeK,
+      sumCornerK,
+      boundaryCorners: r.boundary_corners.length,
+      eulerCharacteristic: report?.euler_characteristic ?? NaN,
+      rounds: r.rounds,
+      featureEdges: r.feature_edges,
+      shownCones: coneText,
+      uv: hasUv,
+      seams: r.seam_edges?.length ?? 0,
+      simulated: Boolean(r.simulated),
+    };
+  }
+
+
+  /** Per-corner colours from per-face distortion; also draws the histogram. */
+  private distortionColors(perFace: Float32Array): Float32Array {
+    const sorted = Float32Array.from(perFace).sort();
+    const p99 = sorted[Math.min(sorted.length - 1, Math.floor(sorted.length * 0.99))] ?? 1;
+    const max = Math.max(p99, 1e-6);
+    const colors = new Float32Array(perFace.length * 9);
+    const c = new THREE.Color();
+    for (let f = 0; f < perFace.length; f++) {
+      heat(perFace[f]! / max, c);
+      for (let k = 0; k < 3; k++) colors.set([c.r, c.g, c.b], 9 * f + 3 * k);
+    }
+    this.el.distortionMax.textContent = fmt(max);
+    this.drawHistogram(perFace, max);
+    return colors;
+  }
+
+  private drawHistogram(values: Float32Array, max: number): void {
+    const canvas = this.el.histogram;
+    const g = canvas.getContext('2d')!;
+    const bins = 40;
+    const counts = new Uint32Array(bins);
+    for (const v of values) counts[Math.min(bins - 1, Math.max(0, Math.floor((v / max) * bins)))]!++;
+    const top = Math.max(...counts, 1);
+    g.clearRect(0, 0, canvas.width, canvas.height);
+    const w = canvas.width / bins;
+    const col = new THREE.Color();
+    for (let i = 0; i < bins; i++) {
+      const h = (counts[i]! / top) * (canvas.height - 4);
+      heat((i + 0.5) / bins, col);
+      g.fillStyle = `#${col.getHexString()}`;
+      g.fillRect(i * w + 0.5, canvas.height - h, w - 1, h);
+    }
+  }
+
+  private setSurface(mode: SurfaceMode): void {
+    for (const radio of document.querySelectorAll<HTMLInputElement>('input[name=surface]')) radio.checked = radio.value === mode;
+    this.viewer.setSurfaceMode(mode);
+    this.uvView.setColored(mode === 'distortion');
+    this.el.distortionLegend.hidden = mode !== 'distortion' || !this.result?.metrics?.per_face_distortion;
+  }
+
+  private baseName(): string {
+    return (this.mesh?.label ?? 'mesh').replace(/ \(\+\d+ more\)$/, '').replace(/\.[^.]+$/, '');
+  }
+
+  /** The report: settings, features, mesh figures and the solver's result (without bulky arrays). */
+  report(): Record<string, unknown> | null {
+    const m = this.mesh;
+    const r = this.result;
+    if (!m || !r) return null;
+    const { uv: _uv, glb: _glb, obj: _obj, seam_edges: seams, metrics, ...rest } = r;
+    const metricsOut = metrics ? { ...metrics, per_face_distortion: undefined } : undefined;
+    return {
+      tool: 'conemap',
+      file: m.label,
+      mesh: m.data.report,
+      settings: this.resultSettings,
+      features: { edges: Array.from(m.features?.ids() ?? []), boundary_edges: m.features?.boundaryCount ?? 0 },
+      result: { ...rest, metrics: metricsOut, seam_edges: seams ? seams.length : undefined },
+    };
+  }
+
+  private downloadJson(): void {
+    const report = this.report();
+    if (report) download(new Blob([`${JSON.stringify(report, null, 2)}\n`], { type: 'application/json' }), `${this.baseName()}-report.json`);
+  }
+
+  // ---- test hooks -------------------------------------------------------
+
+  projectEdge(e: number): { x: number; y: number } | null {
+    const m = this.mesh;
+    if (!m || e < 0 || 2 * e + 1 >= m.edges.length) return null;
+    const p = m.data.positions;
+    const a = m.edges[2 * e]!;
+    const b = m.edges[2 * e + 1]!;
+    return this.viewer.projectPoint((p[3 * a]! + p[3 * b]!) / 2, (p[3 * a + 1]! + p[3 * b + 1]!) / 2, (p[3 * a + 2]! + p[3 * b + 2]!) / 2);
+  }
+
+  edgeAt(x: number, y: number): number {
+    return this.edgeFromPick(x, y);
+  }
+
+  visibleEdge(): number {
+    const m = this.mesh;
+    if (!m?.features) return -1;
+    const rect = this.viewer.canvas.getBoundingClientRect();
+    const n = m.edges.length / 2;
+    // Try edges spread over the mesh until one projects inside the view and picks back to itself.
+    for (let i = 0; i < 400; i++) {
+      const e = Math.floor(((i * 0.6180339887) % 1) * n);
+      if (m.features.boundary[e] || m.features.has(e)) continue;
+      const q = this.projectEdge(e);
+      if (!q || q.x < rect.left + 20 || q.x > rect.right - 20 || q.y < rect.top + 20 || q.y > rect.bottom - 20) continue;
+      if (this.edgeFromPick(q.x, q.y) === e) return e;
+    }
+    return -1;
+  }
+}
+
+function alphaText(a: number): string {
+  return a >= 10 ? a.toFixed(0) : a >= 1 ? a.toFixed(2) : a >= 0.01 ? a.toFixed(3) : a.toExponential(1);
+}
+
+function download(blob: Blob, name: string): void {
+  const url = URL.createObjectURL(blob);
+  const a = document.createElement('a');
+  a.href = url;
+  a.download = name;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10_000);
+}

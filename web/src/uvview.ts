@@ -1,0 +1,208 @@
+// The 2D UV layout beside the 3D view: the parametrized triangles in an
+// orthographic view (pan and zoom, no rotation), coloured by distortion when
+// known, with the hovered face highlighted in sync with the 3D view.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { checkerTexture, checkerUv } from './viewer';
+
+export class UvView {
+  private readonly renderer: THREE.WebGLRenderer;
+  private readonly scene = new THREE.Scene();
+  private readonly camera = new THREE.OrthographicCamera(-1, 1, 1, -1, -10, 10);
+  private readonly controls: OrbitControls;
+  private mesh: THREE.Mesh | null = null;
+  private edges: THREE.LineSegments | null = null;
+  private hover: THREE.Mesh;
+  private seams: THREE.LineSegments | null = null;
+  private checker: THREE.Texture | null = null;
+  private uv: Float32Array | null = null;
+  private frameRequested = false;
+  private readonly raycaster = new THREE.Raycaster();
+  private bounds = new THREE.Box2();
+  /** Called with the face under the pointer (null when none). */
+  onHover: ((face: number | null) => void) | null = null;
+
+  constructor(private readonly container: HTMLElement) {
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    this.renderer.domElement.dataset['testid'] = 'uv-canvas';
+    container.appendChild(this.renderer.domElement);
+    this.scene.background = new THREE.Color(0x20252d);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.enableRotate = false;
+    this.controls.screenSpacePanning = true;
+    this.controls.mouseButtons = { LEFT: THREE.MOUSE.PAN, MIDDLE: THREE.MOUSE.DOLLY, RIGHT: THREE.MOUSE.PAN };
+    this.controls.addEventListener('change', () => this.requestRender());
+    const hg = new THREE.BufferGeometry();
+    hg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3));
+    this.hover = new THREE.Mesh(hg, new THREE.MeshBasicMaterial({ color: 0xfff275, side: THREE.DoubleSide, depthTest: false }));
+    this.hover.visible = false;
+    this.hover.renderOrder = 3;
+    this.scene.add(this.hover);
+
+    let pending: PointerEvent | null = null;
+    this.renderer.domElement.addEventListener('pointermove', (e) => {
+      if (e.buttons) return;
+      if (!pending) {
+        requestAnimationFrame(() => {
+          const ev = pending!;
+          pending = null;
+          this.onHover?.(this.pick(ev.clientX, ev.clientY));
+        });
+      }
+      pending = e;
+    });
+    this.renderer.domElement.addEventListener('pointerleave', () => this.onHover?.(null));
+    new ResizeObserver(() => this.resize()).observe(container);
+  }
+
+  /** Colours the layout by distortion (when given to `show`) or plainly. */
+  setColored(on: boolean): void {
+    if (!this.mesh) return;
+    const m = this.mesh.material as THREE.MeshBasicMaterial;
+    const has = Boolean(this.mesh.geometry.getAttribute('color'));
+    m.vertexColors = on && has;
+    m.map = on && has ? null : (this.checker ??= checkerTexture());
+    m.color.setHex(0xffffff);
+    m.needsUpdate = true;
+    this.requestRender();
+  }
+
+  /**
+   * Shows a layout: `uv` has 2 floats per face corner; `colors` (rgb per corner)
+   * optional; `cutSides` lists face sides (3f+k, corner k → k+1) drawn as chart
+   * outlines (seams and boundary).
+   */
+  show(uv: Float32Array, colors: Float32Array | null, cutSides: Uint32Array | null = null): void {
+    this.clear();
+    this.uv = uv;
+    const corners = uv.length / 2;
+    const pos = new Float32Array(corners * 3);
+    this.bounds.makeEmpty();
+    const p = new THREE.Vector2();
+    for (let c = 0; c < corners; c++) {
+      pos[3 * c] = uv[2 * c]!;
+      pos[3 * c + 1] = uv[2 * c + 1]!;
+      this.bounds.expandByPoint(p.set(uv[2 * c]!, uv[2 * c + 1]!));
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+    g.setAttribute('uv', new THREE.BufferAttribute(checkerUv(uv), 2));
+    if (colors) g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
+    g.computeBoundingSphere();
+    this.mesh = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ side: THREE.DoubleSide }));
+    this.scene.add(this.mesh);
+    this.setColored(false);
+    if (cutSides && cutSides.length) {
+      const seg = new Float32Array(cutSides.length * 6);
+      for (let i = 0; i < cutSides.length; i++) {
+        const s = cutSides[i]!;
+        const f = Math.floor(s / 3);
+        const a = 3 * f + (s % 3);
+        const b = 3 * f + ((s % 3) + 1) % 3;
+        seg.set([uv[2 * a]!, uv[2 * a + 1]!, 0.005, uv[2 * b]!, uv[2 * b + 1]!, 0.005], 6 * i);
+      }
+      const sg = new THREE.BufferGeometry();
+      sg.setAttribute('position', new THREE.BufferAttribute(seg, 3));
+      this.seams = new THREE.LineSegments(sg, new THREE.LineBasicMaterial({ color: 0xff4fa3 }));
+      this.seams.renderOrder = 2;
+      this.scene.add(this.seams);
+    }
+    // Triangle outlines only for layouts small enough to read.
+    if (corners / 3 <= 4_000) {
+      const idx = new Uint32Array(corners * 2);
+      for (let f = 0; f < corners / 3; f++) {
+        for (let k = 0; k < 3; k++) {
+          idx[6 * f + 2 * k] = 3 * f + k;
+          idx[6 * f + 2 * k + 1] = 3 * f + ((k + 1) % 3);
+        }
+      }
+      const lg = new THREE.BufferGeometry();
+      lg.setAttribute('position', g.getAttribute('position'));
+      lg.setIndex(new THREE.BufferAttribute(idx, 1));
+      this.edges = new THREE.LineSegments(lg, new THREE.LineBasicMaterial({ color: 0x111720, transparent: true, opacity: 0.35 }));
+      this.scene.add(this.edges);
+    }
+    this.frame();
+  }
+
+  clear(): void {
+    for (const o of [this.mesh, this.edges, this.seams]) {
+      if (!o) continue;
+      this.scene.remove(o);
+      o.geometry.dispose();
+      (o.material as THREE.Material).dispose();
+    }
+    this.mesh = null;
+    this.edges = null;
+    this.seams = null;
+    this.uv = null;
+    this.hover.visible = false;
+    this.requestRender();
+  }
+
+  frame(): void {
+    if (this.bounds.isEmpty()) return;
+    const c = this.bounds.getCenter(new THREE.Vector2());
+    const s = this.bounds.getSize(new THREE.Vector2());
+    this.controls.target.set(c.x, c.y, 0);
+    this.camera.position.set(c.x, c.y, 5);
+    this.camera.zoom = 1;
+    this.span = Math.max(s.x, s.y, 1e-9) * 0.55;
+    this.resize();
+    this.controls.update();
+  }
+
+  private span = 1;
+
+  setHoverFace(face: number | null): void {
+    if (face === null || !this.uv || 6 * face + 5 >= this.uv.length) {
+      this.hover.visible = false;
+    } else {
+      const a = this.hover.geometry.getAttribute('position') as THREE.BufferAttribute;
+      for (let k = 0; k < 3; k++) a.setXYZ(k, this.uv[6 * face + 2 * k]!, this.uv[6 * face + 2 * k + 1]!, 0.01);
+      a.needsUpdate = true;
+      this.hover.geometry.computeBoundingSphere();
+      this.hover.visible = true;
+    }
+    this.requestRender();
+  }
+
+  private pick(clientX: number, clientY: number): number | null {
+    if (!this.mesh) return null;
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+    this.raycaster.setFromCamera(ndc, this.camera);
+    const hit = this.raycaster.intersectObject(this.mesh, false)[0];
+    return hit?.faceIndex ?? null;
+  }
+
+  private resize(): void {
+    const { clientWidth: w, clientHeight: h } = this.container;
+    if (w === 0 || h === 0) return;
+    this.renderer.setSize(w, h, false);
+    const aspect = w / h;
+    const c = this.controls.target;
+    this.camera.left = -this.span * aspect;
+    this.camera.right = this.span * aspect;
+    this.camera.top = this.span;
+    this.camera.bottom = -this.span;
+    this.camera.position.x = c.x;
+    this.camera.position.y = c.y;
+    this.camera.updateProjectionMatrix();
+    this.requestRender();
+  }
+
+  requestRender(): void {
+    if (this.frameRequested) return;
+    this.frameRequested = true;
+    requestAnimationFrame(() => {
+      this.frameRequested = false;
+      this.renderer.render(this.scene, this.camera);
+    });
+  }
+
+  renderNow(): void {
+    this.renderer.render(this.scene, this.camera);
+  }
+}
