@@ -185,6 +185,66 @@ function subObj(source, levels) {
   return { file, faces };
 }
 
+/**
+ * The whole method natively (`conemap solve --report`): fandisk with its sharp
+ * edges (> 60°) as features and without features, α = 0.01; one row per stage.
+ */
+function nativeSolve(ctx) {
+  const build = spawnSync('cargo', ['build', '--quiet', '--release', '-p', 'conemap', '--bin', 'conemap'], { cwd: root, env, encoding: 'utf8' });
+  if (build.status !== 0) return { skipped: `cargo build failed: ${(build.stderr || '').trim().split('\n').slice(-2).join(' | ')}` };
+  const bin = path.join(root, 'target/release/conemap');
+  const file = ctx.inputs[0].file;
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-solve-'));
+  const rows = [];
+  for (const [label, extra] of [['sharp > 60°', ['--sharp', '60']], ['no features', []]]) {
+    const report = path.join(dir, 'report.json');
+    const r = spawnSync(bin, ['solve', file, ...extra, '-o', path.join(dir, 'out.glb'), '--report', report], { encoding: 'utf8' });
+    if (r.status !== 0) return { skipped: `conemap solve failed: ${(r.stderr || '').trim()}` };
+    const j = JSON.parse(fs.readFileSync(report, 'utf8'));
+    const t = j.timings;
+    const input = `${path.basename(file)} (${label})`;
+    const note = `${j.cones.length} cones, ${j.rounds} rounds, distortion ${j.metrics.distortion.toFixed(3)}, ${j.metrics.flipped} flipped`;
+    for (const [stage, sec] of [
+      ['import', t.import],
+      ['cones: topology', t.cones.topology],
+      ['cones: rounding', t.cones.rounding],
+      ['cones: moves + clean-up', t.cones.cone_moves],
+      ['param: field + cut', t.param.field + t.param.cut],
+      ['param: Poisson + ARAP', t.param.poisson + t.param.arap],
+      ['param: repair', t.param.repair],
+      ['export', t.export],
+      ['file → UVs total', t.total],
+    ]) rows.push({ stage, input, faces: j.output.faces, ms: sec * 1000, note: stage.endsWith('total') ? note : '' });
+  }
+  fs.rmSync(dir, { recursive: true, force: true });
+  return rows;
+}
+
+/** The whole method in wasm under node: fandisk, sharp edges > 60° as features, α = 0.01. */
+function wasmNodeSolve(ctx) {
+  const pkg = path.join(root, 'build/pkg-node/conemap.js');
+  if (!fs.existsSync(pkg)) return { skipped: 'build/pkg-node missing (run npm run build)' };
+  const wasm = createRequire(import.meta.url)(pkg);
+  const file = ctx.inputs[0].file;
+  const t0 = performance.now();
+  const session = wasm.MeshSession.open([{ name: path.basename(file), bytes: new Uint8Array(fs.readFileSync(file)) }]);
+  try {
+    const r = session.solve(session.sharp_edges(60), 0.01, false, () => {});
+    const ms = performance.now() - t0;
+    const t = r.timings;
+    const p = r.param_timings;
+    const input = path.basename(file);
+    return [
+      { stage: 'cones (rounding)', input, ms: t.rounding * 1000, note: `${r.rounds} rounds` },
+      { stage: 'cones total', input, ms: t.total * 1000, note: `${r.cones.length} cones` },
+      { stage: 'param (Poisson + ARAP + repair)', input, ms: (p.poisson + p.arap + p.repair) * 1000, note: '' },
+      { stage: 'file → UVs + GLB total', input, ms, note: `distortion ${r.metrics.distortion.toFixed(3)}, ${r.metrics.flipped} flipped` },
+    ];
+  } finally {
+    session.free();
+  }
+}
+
 /** Cone placement in wasm under node: fandisk with its sharp edges (> 60°) as features, α = 1. */
 function wasmNodeCones(ctx) {
   const pkg = path.join(root, 'build/pkg-node/conemap.js');
@@ -348,6 +408,8 @@ const BENCHES = [
   { env: 'native', stage: 'ldlt', run: () => cargoExample('bench_ldlt', [], 'bumpy grid'), enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'import', run: wasmNodeImport, enabled: true },
   { env: 'wasm-node', stage: 'cones', run: wasmNodeCones, enabled: true },
+  { env: 'native', stage: 'solve', run: nativeSolve, enabled: !args.has('--no-native') },
+  { env: 'wasm-node', stage: 'solve', run: wasmNodeSolve, enabled: true },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },
 ];
