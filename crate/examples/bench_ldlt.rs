@@ -13,29 +13,11 @@ use conemap::operators::{cotan_laplacian_triplets, vertex_areas};
 
 fn grid(nx: usize, ny: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let h = 1.0 / nx.max(ny) as f64;
-    let mut p = Vec::with_capacity((nx + 1) * (ny + 1));
-    for j in 0..=ny {
-        for i in 0..=nx {
-            let (x, y) = (i as f64 * h, j as f64 * h);
-            let z = 0.08 * (7.0 * x).sin() * (5.0 * y).cos();
-            p.push([x, y, z]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut t = Vec::with_capacity(2 * nx * ny);
-    for j in 0..ny {
-        for i in 0..nx {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if (i + j) % 2 == 0 {
-                t.push([a, b, c]);
-                t.push([a, c, d]);
-            } else {
-                t.push([a, b, d]);
-                t.push([b, c, d]);
-            }
-        }
-    }
-    (p, t)
+    let raw = conemap::mesh::shapes::grid(nx, ny, |u, v| {
+        let (x, y) = (u * nx as f64 * h, v * ny as f64 * h);
+        [x, y, 0.08 * (7.0 * x).sin() * (5.0 * y).cos()]
+    });
+    (raw.positions, raw.triangles)
 }
 
 fn ms(t: Instant) -> f64 {

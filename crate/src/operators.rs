@@ -261,27 +261,8 @@ mod tests {
     /// (nx+1)×(ny+1) grid on [0, nx·h]×[0, ny·h] in the z = 0 plane, split
     /// into triangles with alternating diagonals.
     fn grid(nx: usize, ny: usize, h: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-        let mut p = Vec::new();
-        for j in 0..=ny {
-            for i in 0..=nx {
-                p.push([i as f64 * h, j as f64 * h, 0.0]);
-            }
-        }
-        let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-        let mut t = Vec::new();
-        for j in 0..ny {
-            for i in 0..nx {
-                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                if (i + j) % 2 == 0 {
-                    t.push([a, b, c]);
-                    t.push([a, c, d]);
-                } else {
-                    t.push([a, b, d]);
-                    t.push([b, c, d]);
-                }
-            }
-        }
-        (p, t)
+        let raw = crate::mesh::shapes::grid(nx, ny, |x, y| [x * nx as f64 * h, y * ny as f64 * h, 0.0]);
+        (raw.positions, raw.triangles)
     }
 
     fn octahedron() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {

@@ -129,9 +129,7 @@ impl MeshSession {
         miq: bool,
         progress: &Function,
     ) -> Result<JsValue, JsError> {
-        let mesh = self.valid_mesh()?;
-        let features = self.features(mesh, feature_edges)?;
-        let options = self.cone_options(alpha_smooth, miq)?;
+        let (mesh, features, options) = self.request(feature_edges, alpha_smooth, miq)?;
         let mut report = |p: Progress| {
             let (stage, a, b) = cone_stage(&p);
             let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
@@ -155,9 +153,8 @@ impl MeshSession {
         miq: bool,
         progress: &Function,
     ) -> Result<JsValue, JsError> {
-        let mesh = self.valid_mesh()?;
-        let features = self.features(mesh, feature_edges)?;
-        let options = SolveOptions { cones: self.cone_options(alpha_smooth, miq)?, param: ParamOptions::default() };
+        let (mesh, features, cone_options) = self.request(feature_edges, alpha_smooth, miq)?;
+        let options = SolveOptions { cones: cone_options, param: ParamOptions::default() };
         let mut report = |p: SolveProgress| {
             let (stage, a, b) = match p {
                 SolveProgress::Cones(p) => cone_stage(&p),
@@ -200,12 +197,16 @@ impl MeshSession {
 }
 
 impl MeshSession {
-    fn cone_options(&self, alpha_smooth: f64, miq: bool) -> Result<ConeOptions, JsError> {
+    /// Checks a cones/solve request: the valid mesh, its features from edge
+    /// ids, and the cone options.
+    fn request(&self, feature_edges: &[u32], alpha_smooth: f64, miq: bool) -> Result<(&TriMesh, FeatureSet, ConeOptions), JsError> {
+        let mesh = self.valid_mesh()?;
+        let features = self.features(mesh, feature_edges)?;
         let (lo, hi) = cones::ALPHA_RANGE;
         if !(lo..=hi).contains(&alpha_smooth) {
             return Err(JsError::new(&format!("alpha_smooth {alpha_smooth} is outside {lo}..{hi}")));
         }
-        Ok(ConeOptions { alpha_smooth, miq, ..ConeOptions::default() })
+        Ok((mesh, features, ConeOptions { alpha_smooth, miq, ..ConeOptions::default() }))
     }
 
     fn valid_mesh(&self) -> Result<&TriMesh, JsError> {

@@ -9,30 +9,10 @@ pub fn octahedron() -> TriMesh {
     TriMesh::from_welded_arrays(p, t).unwrap()
 }
 
-/// An `nx` × `ny` grid of squares on [0, 1]², each split into two
-/// triangles, mapped through `embed`.
+/// An `nx` × `ny` grid of squares on [0, 1]² mapped through `embed`.
 pub fn grid(nx: usize, ny: usize, embed: impl Fn(f64, f64) -> [f64; 3]) -> TriMesh {
-    let mut p = Vec::new();
-    for j in 0..=ny {
-        for i in 0..=nx {
-            p.push(embed(i as f64 / nx as f64, j as f64 / ny as f64));
-        }
-    }
-    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if (i + j) % 2 == 0 {
-                t.push([a, b, c]);
-                t.push([a, c, d]);
-            } else {
-                t.push([a, b, d]);
-                t.push([b, c, d]);
-            }
-        }
-    }
-    TriMesh::from_welded_arrays(p, t).unwrap()
+    let raw = crate::mesh::shapes::grid(nx, ny, embed);
+    TriMesh::from_welded_arrays(raw.positions, raw.triangles).unwrap()
 }
 
 /// A torus of revolution with `nu` × `nv` quads split in two.

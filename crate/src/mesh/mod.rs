@@ -6,6 +6,7 @@
 //! [`TriMesh::from_raw`] (fails with the blocking problems).
 
 mod raw;
+pub mod shapes;
 mod subdivide;
 mod topology;
 mod trimesh;

@@ -1,0 +1,30 @@
+//! Synthetic meshes for tests and benchmarks.
+
+use super::RawMesh;
+
+/// An `nx` × `ny` grid of squares over [0, 1]² (vertex `(i, j)` at
+/// `embed(i / nx, j / ny)`, index `j (nx + 1) + i`), each square split into
+/// two counter-clockwise triangles with alternating diagonals.
+pub fn grid(nx: usize, ny: usize, embed: impl Fn(f64, f64) -> [f64; 3]) -> RawMesh {
+    let mut positions = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            positions.push(embed(i as f64 / nx as f64, j as f64 / ny as f64));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut triangles = Vec::with_capacity(2 * nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            } else {
+                triangles.push([a, b, d]);
+                triangles.push([b, c, d]);
+            }
+        }
+    }
+    RawMesh { positions, triangles }
+}
