@@ -241,6 +241,27 @@ pub fn solve(
             best_uv = uv.clone();
         }
     }
+    // Relaxation: once fold-free, decay the repair weights back towards 1
+    // (less distortion) for as long as the map stays fold-free.
+    if best_flips == 0 && round > 0 {
+        uv = best_uv.clone();
+        for _ in 0..16 {
+            for w in weights.iter_mut() {
+                *w = 1.0 + (*w - 1.0) * 0.85;
+            }
+            sys.refactor(&weights)?;
+            let mut trial = uv.clone();
+            let mut r_trial = r.clone();
+            let (_, e) = arap(&sys, &weights, &pinned, &mut r_trial, &mut trial, options, 10, &mut |_| {})?;
+            if !flipped_faces(&sys, &trial).is_empty() {
+                break;
+            }
+            uv = trial;
+            r = r_trial;
+            energy = e;
+            best_uv = uv.clone();
+        }
+    }
     timings.repair = clock.lap();
     Ok(SeamlessResult {
         uv: best_uv,
