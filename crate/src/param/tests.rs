@@ -75,3 +75,33 @@ fn mismatched_placement_is_an_error() {
     let r = parametrize(&b, &placement, &ParamOptions::default(), &mut |_| {});
     assert!(matches!(r, Err(ParamError::MeshMismatch { .. })));
 }
+
+/// Smallest ratio of UV area to 3D area over all faces, after scaling the
+/// UVs so the total areas match.
+fn min_area_ratio(mesh: &TriMesh, uv: &[[f64; 2]]) -> f64 {
+    let areas = crate::operators::face_areas(mesh.positions(), mesh.faces());
+    let uv_areas: Vec<f64> = (0..mesh.n_faces())
+        .map(|f| seamless::signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]))
+        .collect();
+    let scale = areas.iter().sum::<f64>() / uv_areas.iter().sum::<f64>();
+    (0..mesh.n_faces()).map(|f| uv_areas[f] * scale / areas[f]).fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn ring_with_flap_does_not_collapse_while_miq_emulation_does() {
+    // Figure 10: without cones the boundary-aligned map must squeeze the flap.
+    let mesh = crate::cones::test_meshes::ring_with_flap(96);
+    let none = FeatureSet::none(&mesh);
+    let ours = run(&mesh, &none).1;
+    let ours_min = min_area_ratio(&mesh, &ours.uv);
+    let options = ConeOptions { alpha_smooth: crate::cones::MIQ_ALPHA, miq: true, ..ConeOptions::default() };
+    let placement = place_cones(&mesh, &none, &options, &mut |_| {}).unwrap();
+    assert!(placement.cones.is_empty());
+    let miq_min = match parametrize(&mesh, &placement, &ParamOptions::default(), &mut |_| {}) {
+        Ok(p) => min_area_ratio(&mesh, &p.uv),
+        Err(_) => 0.0, // a collapsed system is a collapse too
+    };
+    eprintln!("ring with flap: smallest UV/3D area ratio {ours_min:.3} (ours) vs {miq_min:.2e} (MIQ emulation)");
+    assert!(ours_min > 0.05, "our map: smallest area ratio {ours_min}");
+    assert!(miq_min < 0.2 * ours_min, "MIQ emulation should collapse the flap: {miq_min} vs {ours_min}");
+}
