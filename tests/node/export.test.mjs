@@ -9,6 +9,7 @@ import { before, describe, it } from 'node:test';
 import validator from 'gltf-validator';
 import { makeGltfFixtures } from './make-gltf.mjs';
 import { committedFandisk, root, sharedMesh } from './wasm.mjs';
+import { checkUv, parseObj } from './uvcheck.mjs';
 
 const exe = path.join(root, 'target/release/conemap');
 
@@ -110,6 +111,13 @@ describe('conemap solve', () => {
         assert.ok(count('vt ') >= source.vertices, `${input.label}: vt ${count('vt ')} ≥ ${source.vertices} vertices`);
         assert.equal(count('vt '), rep.output.vertices);
         assert.equal(count('v '), source.vertices);
+        // Independent check from the file alone (OBJ keeps full precision).
+        const c = checkUv(parseObj(text));
+        assert.equal(c.flipped, 0, `${input.label}: flipped triangles`);
+        assert.ok(c.seams > 0, `${input.label}: a closed or cut surface has seams`);
+        assert.ok(c.maxSeamAngle < 1e-6, `${input.label}: seam transition off a quarter turn by ${c.maxSeamAngle} rad`);
+        assert.ok(c.maxSeamLength < 1e-6, `${input.label}: seam length mismatch ${c.maxSeamLength}`);
+        assert.ok(c.maxBoundaryAxis < 1e-6, `${input.label}: boundary edge off axis by ${c.maxBoundaryAxis} rad`);
       } else {
         const v = await validate(out);
         assert.equal(v.info.totalTriangleCount ?? source.faces, source.faces);
