@@ -7,6 +7,8 @@ import { after, before, describe, it } from 'node:test';
 import { fileURLToPath } from 'node:url';
 import { launchChromium } from '../../scripts/lib/chromium.mjs';
 import { startServer } from '../../scripts/serve.mjs';
+import validator from 'gltf-validator';
+import { checkUv, edgeAlignment, parseObj } from '../node/uvcheck.mjs';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const dist = path.join(root, 'dist');
@@ -186,9 +188,20 @@ describe('feature editing and solving', () => {
     const bytes = fs.readFileSync(await glb.path());
     assert.equal(bytes.subarray(0, 4).toString('latin1'), 'glTF');
     assert.match(glb.suggestedFilename(), /^fandisk-uv\.glb$/);
+    const validation = await validator.validateBytes(new Uint8Array(bytes), { uri: 'fandisk-uv.glb', maxIssues: 0 });
+    assert.equal(validation.issues.numErrors, 0, JSON.stringify(validation.issues.messages.slice(0, 3)));
     const [obj] = await Promise.all([page.waitForEvent('download'), page.getByTestId('download-obj').click()]);
     const text = fs.readFileSync(await obj.path(), 'utf8');
     assert.match(text, /^vt /m);
+    // Re-import the download and check it from the file alone: seamless, no
+    // fold-overs, and every marked feature edge on a u or v isoline.
+    const parsed = parseObj(text);
+    const check = checkUv(parsed);
+    assert.equal(check.flipped, 0, 'flipped triangles in the download');
+    assert.ok(check.maxSeamAngle < 1e-6 && check.maxSeamLength < 1e-6, `seams: ${JSON.stringify(check)}`);
+    const aligned = edgeAlignment(parsed, report.features.positions, 1e-4);
+    assert.equal(aligned.missing, 0, 'every marked edge is in the download');
+    assert.ok(aligned.worst < 1e-6, `a marked edge is ${aligned.worst} rad off the nearest axis`);
     assert.ok(report.result.metrics && typeof report.result.metrics.distortion === 'number', 'metrics in the report');
   });
 

@@ -74,3 +74,44 @@ export function checkUv({ v, vt, faces }) {
   }
   return { maxSeamAngle, maxSeamLength, maxBoundaryAxis, flipped, seams, vertices: weld.size };
 }
+
+/**
+ * Largest angle between the UV image of each given edge (end positions, as
+ * in a features file) and the nearest axis, over every face side of it.
+ * Ends match the nearest vertex within `tolerance`; unmatched edges count.
+ */
+export function edgeAlignment({ v, vt, faces }, edges, tolerance) {
+  const near = (p) => {
+    let best = -1;
+    let bd = tolerance;
+    for (let i = 0; i < v.length; i++) {
+      const d = Math.hypot(v[i][0] - p[0], v[i][1] - p[1], v[i][2] - p[2]);
+      if (d <= bd) [best, bd] = [i, d];
+    }
+    return best;
+  };
+  const key = (i) => v[i].join(',');
+  let worst = 0;
+  let missing = 0;
+  for (const [p, q] of edges) {
+    const [a, b] = [near(p), near(q)];
+    if (a < 0 || b < 0) {
+      missing += 1;
+      continue;
+    }
+    let found = false;
+    for (const f of faces) {
+      for (let k = 0; k < 3; k++) {
+        const [c, d] = [f[k], f[(k + 1) % 3]];
+        const ends = [key(c[0]), key(d[0])];
+        if ((ends[0] === key(a) && ends[1] === key(b)) || (ends[0] === key(b) && ends[1] === key(a))) {
+          const [s, t] = [vt[c[1]], vt[d[1]]];
+          worst = Math.max(worst, angleTo90(Math.atan2(t[1] - s[1], t[0] - s[0])));
+          found = true;
+        }
+      }
+    }
+    if (!found) missing += 1;
+  }
+  return { worst, missing };
+}

@@ -592,7 +592,12 @@ export class Editor {
       file: m.label,
       mesh: m.data.report,
       settings: this.resultSettings,
-      features: { edges: Array.from(m.features?.ids() ?? []), boundary_edges: m.features?.boundaryCount ?? 0 },
+      features: {
+        edges: Array.from(m.features?.ids() ?? []),
+        // End positions too: the same form as `conemap solve --features FILE`.
+        positions: Array.from(m.features?.ids() ?? [], (e) => [m.edges[2 * e]!, m.edges[2 * e + 1]!].map((v) => Array.from(m.data.positions.subarray(3 * v, 3 * v + 3)))),
+        boundary_edges: m.features?.boundaryCount ?? 0,
+      },
       result: { ...rest, metrics: metricsOut, seam_edges: seams ? seams.length : undefined },
     };
   }
