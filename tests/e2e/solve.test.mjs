@@ -206,11 +206,7 @@ describe('feature editing and solving', () => {
   });
 
   it('shows UVs: checkerboard, distortion heat map with histogram, UV layout with hover sync', async () => {
-    // With a wasm build that has `solve` these are its UVs; without, a test-only
-    // stand-in supplies them (web/src/fake-uv.ts) so that the display is still tested.
-    await page.evaluate(() => window.__conemapTest.simulateUv(true));
     const h = await runSolve();
-    await page.evaluate(() => window.__conemapTest.simulateUv(false));
     assert.equal(h.state, 'solved', h.solveError ?? '');
     assert.equal(h.result.uv, true);
     assert.ok(h.result.seams > 0, 'no seams');

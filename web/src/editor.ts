@@ -25,7 +25,6 @@ export interface EditorHooks {
     shownCones: string;
     uv: boolean;
     seams: number;
-    simulated: boolean;
   } | null;
   solveError: string | null;
   solves: number;
@@ -93,7 +92,6 @@ export class Editor {
     json: $<HTMLButtonElement>('download-json'),
     uv: $('uv-view'),
     uvFrame: $<HTMLButtonElement>('uv-frame'),
-    simulated: $('simulated-note'),
   };
 
   constructor(
@@ -366,9 +364,6 @@ export class Editor {
     else this.el.bar.value = Math.max(0, Math.min(1, frac));
   }
 
-  /** Test hook: the next runs add stand-in UVs when the build has no `solve` (fake-uv.ts). */
-  simulateUv = false;
-
   async run(): Promise<void> {
     const m = this.mesh;
     if (!m || this.solving) return;
@@ -394,7 +389,7 @@ export class Editor {
     try {
       const result = await this.worker.solve(features, alpha, miq, (stage, step, remaining) => {
         if (this.mesh === m) this.setProgress(stage, step, remaining);
-      }, this.simulateUv && !m.data.canSolve);
+      });
       if (this.mesh !== m) return;
       this.clearResult();
       this.result = result;
@@ -498,7 +493,6 @@ export class Editor {
     this.el.obj.disabled = !r.obj;
     this.el.json.disabled = false;
     this.el.distortionLegend.hidden = true;
-    this.el.simulated.hidden = !r.simulated;
     if (hasUv && r.uv) {
       const perFace = metrics?.per_face_distortion;
       const colors = perFace ? this.distortionColors(perFace) : null;
@@ -530,7 +524,6 @@ export class Editor {
       shownCones: coneText,
       uv: hasUv,
       seams: r.seam_edges?.length ?? 0,
-      simulated: Boolean(r.simulated),
     };
   }
 

@@ -47,7 +47,6 @@ export interface ResultHook {
   shownCones: string;
   uv: boolean;
   seams: number;
-  simulated: boolean;
 }
 declare global {
   interface Window {
@@ -62,7 +61,6 @@ declare global {
       /** Edge id a click at (x, y) would toggle; -1 when none. */
       edgeAt(x: number, y: number): number;
       /** Later runs add stand-in UVs (fake-uv.ts) when the build has no `solve`, to exercise the UV display. */
-      simulateUv(on: boolean): void;
     };
   }
 }
@@ -231,9 +229,6 @@ window.__conemapTest = {
   projectEdge: (e) => editor.projectEdge(e),
   visibleEdge: () => editor.visibleEdge(),
   edgeAt: (x, y) => editor.edgeAt(x, y),
-  simulateUv: (on) => {
-    editor.simulateUv = on;
-  },
 };
 
 void listSamples();

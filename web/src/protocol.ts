@@ -26,8 +26,6 @@ export type Request =
       features: Uint32Array;
       alphaSmooth: number;
       miq: boolean;
-      /** Test hook: add stand-in UVs (fake-uv.ts) when the build has no `solve`. */
-      simulateUv?: boolean;
     };
 
 export type Stage = 'starting' | 'parsing' | 'analysing' | 'transferring';
@@ -120,8 +118,6 @@ export interface SolveResult {
   uv?: Float32Array;
   seam_edges?: Uint32Array;
   metrics?: SolveMetrics;
-  /** The UVs are the test stand-in (fake-uv.ts), not a parametrization. */
-  simulated?: boolean;
   /** Exports, produced in the worker right after the solve. */
   glb?: Uint8Array;
   obj?: string;

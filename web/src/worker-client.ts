@@ -127,7 +127,7 @@ export class MeshWorker {
   }
 
   /** Cones (and UVs when the build can) for the open mesh. */
-  solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn, simulateUv = false): Promise<SolveResult> {
-    return this.send<SolveResult>({ type: 'solve', features, alphaSmooth, miq, ...(simulateUv ? { simulateUv } : {}) }, [], onProgress);
+  solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn): Promise<SolveResult> {
+    return this.send<SolveResult>({ type: 'solve', features, alphaSmooth, miq }, [], onProgress);
   }
 }

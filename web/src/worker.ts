@@ -5,7 +5,6 @@
 import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
 import type { ImportResult, MeshReport, Request, Response, SolveResult } from './protocol';
-import { fakeUv } from './fake-uv';
 import { buildAdjacency, faceEdges } from './topology';
 
 interface WorkerScope {
@@ -33,8 +32,6 @@ interface Session {
   free(): void;
 }
 let session: Session | null = null;
-/** Geometry of the open session, for the test stand-in UVs. */
-let geometry: { positions: Float32Array; indices: Uint32Array; faceEdges: Uint32Array; edgeCount: number } | null = null;
 
 function post(message: Response, transfer: Transferable[] = []): void {
   scope.postMessage(message, transfer);
@@ -54,7 +51,6 @@ function openMesh(req: Extract<Request, { type: 'import' }>): { value: unknown; 
   const next = MeshSession.open(files) as unknown as Session;
   session?.free();
   session = next;
-  geometry = null;
   if (req.quiet) return { value: null, transfer: [] };
   const positions = next.positions();
   const indices = next.indices();
@@ -78,7 +74,6 @@ function openMesh(req: Extract<Request, { type: 'import' }>): { value: unknown; 
   }
   const t2 = performance.now();
   // Only builds without `solve` need the copies (for the test stand-in UVs).
-  if (valid && edges && typeof next.solve !== 'function') geometry = { positions: positions.slice(), indices: indices.slice(), faceEdges: faceEdgeIds.slice(), edgeCount: edges.length / 2 };
   post({ id, type: 'progress', stage: 'transferring' });
   const result: ImportResult = {
     positions,
@@ -153,13 +148,6 @@ function solve(req: Extract<Request, { type: 'solve' }>): { value: unknown; tran
     return { value, transfer };
   }
   const r = s.place_cones(req.features, req.alphaSmooth, req.miq, progress);
-  if (req.simulateUv && geometry) {
-    const g = geometry;
-    const fake = fakeUv(g.positions, g.indices, g.faceEdges, g.edgeCount);
-    fake.metrics.cones = r.cones.length;
-    const value: SolveResult = { ...r, ...fake, simulated: true, elapsed: performance.now() - t0 };
-    return { value, transfer: [fake.uv.buffer, fake.seam_edges.buffer, fake.metrics.per_face_distortion!.buffer] };
-  }
   return { value: { ...r, elapsed: performance.now() - t0 }, transfer: [] };
 }
 
