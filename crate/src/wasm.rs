@@ -7,6 +7,7 @@ use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::{self, ParamOptions, ParamProgress};
 use crate::pipeline::{self, SolveOptions, SolveProgress};
 use crate::features::FeatureSet;
+use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
 use crate::mesh::{self, MeshReport, RawMesh, TriMesh};
 use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, Uint8Array};
@@ -38,6 +39,10 @@ pub fn import_mesh(files: Array) -> Result<JsValue, JsError> {
 #[wasm_bindgen]
 pub struct MeshSession {
     raw: RawMesh,
+    /// The input files and, for glTF, where each vertex came from: exports
+    /// carry the input's normals and materials over.
+    files: Vec<InputFile>,
+    source: Option<GltfSource>,
     report: MeshReport,
     positions: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
@@ -51,7 +56,7 @@ impl MeshSession {
     pub fn open(files: Array) -> Result<MeshSession, JsError> {
         let files = input_files(&files)?;
         let (main, others) = files.split_first().ok_or_else(|| JsError::new("no file given"))?;
-        let raw = io::import(main, others).map_err(|e| JsError::new(&e.to_string()))?;
+        let (raw, source) = io::import_with_source(main, others).map_err(|e| JsError::new(&e.to_string()))?;
         let report = mesh::analyze(&raw);
         let mesh = TriMesh::from_raw(&raw).ok();
         let (positions, triangles) = match &mesh {
@@ -61,7 +66,7 @@ impl MeshSession {
                 (w.positions, w.triangles)
             }
         };
-        Ok(MeshSession { raw, report, positions, triangles, mesh })
+        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh })
     }
 
     /// The mesh report (`MeshReport` plus `problem_messages`, one line each).
@@ -187,8 +192,11 @@ impl MeshSession {
         set(&out, "split_edges", &(sol.splits as f64).into())?;
         // Exports of the solved mesh (with any split edges), exactly.
         let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
-        let input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &sol.param.uv)
+        let mut input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &sol.param.uv)
             .map_err(|e| JsError::new(&e.to_string()))?;
+        if let (Some(source), 0) = (&self.source, sol.splits) {
+            input = input.with_gltf_source(source, &self.files[0], &self.files[1..]);
+        }
         let glb = export::write_glb(&input, &ExportOptions::default());
         set(&out, "glb", &Uint8Array::from(&glb[..]).into())?;
         set(&out, "obj", &export::write_obj(&input, &ExportOptions::default()).into())?;

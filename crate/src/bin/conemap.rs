@@ -359,14 +359,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
     let name = Path::new(file).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let main = InputFile { name, bytes };
     let others = io::gltf::sibling_buffers(Path::new(file), &main).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
-    let lower = main.name.to_ascii_lowercase();
-    let is_gltf = main.bytes.starts_with(b"glTF") || lower.ends_with(".glb") || lower.ends_with(".gltf");
-    let (raw, source) = if is_gltf {
-        let (raw, source) = io::gltf::import_with_source(&main, &others).map_err(|e| Failure(e.to_string(), 1))?;
-        (raw, Some(source))
-    } else {
-        (io::import(&main, &others).map_err(|e| Failure(e.to_string(), 1))?, None)
-    };
+    let (raw, source) = io::import_with_source(&main, &others).map_err(|e| Failure(e.to_string(), 1))?;
     let mesh = TriMesh::from_raw(&raw).map_err(|problems| {
         let first = problems.first().map(|p| p.to_string()).unwrap_or_default();
         let more = if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };

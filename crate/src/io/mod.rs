@@ -30,6 +30,21 @@ pub fn import(main: &InputFile, others: &[InputFile]) -> Result<RawMesh, ImportE
     }
 }
 
+/// Like [`import`], also returning where each vertex came from when the
+/// input is glTF (so an export can carry its normals and materials over).
+pub fn import_with_source(main: &InputFile, others: &[InputFile]) -> Result<(RawMesh, Option<gltf::GltfSource>), ImportError> {
+    if main.bytes.is_empty() {
+        return Err(ImportError::Empty { name: main.name.clone() });
+    }
+    let lower = main.name.to_ascii_lowercase();
+    if main.bytes.starts_with(b"glTF") || lower.ends_with(".glb") || lower.ends_with(".gltf") {
+        let (raw, source) = gltf::import_with_source(main, others)?;
+        Ok((raw, Some(source)))
+    } else {
+        Ok((import(main, others)?, None))
+    }
+}
+
 /// Reads a file and its siblings from disk (native only) and imports it.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn import_path(path: &std::path::Path) -> Result<RawMesh, Box<dyn std::error::Error>> {
