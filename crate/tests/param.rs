@@ -66,6 +66,7 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
     assert!(m.alignment_residual < 1e-6, "{name}: alignment residual {}", m.alignment_residual);
     let allowed = (max_flip_fraction * m.faces as f64).floor() as usize;
     assert!(m.flipped <= allowed, "{name}: {} flipped triangles (allowed {allowed})", m.flipped);
+    assert_eq!(m.wound_vertices, 0, "{name}: the map winds more than once around a vertex");
     assert!(m.distortion < max_distortion, "{name}: distortion {}", m.distortion);
 
     // UV angle sums at interior vertices: 2 pi - k pi/2.

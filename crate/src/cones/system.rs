@@ -484,7 +484,7 @@ impl<'a> ComponentSystem<'a> {
     /// cones within two rings of a moved cone are reconsidered. Returns the
     /// moves made.
     pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
-        const EXACT_TRIES: usize = 1;
+        const EXACT_TRIES: usize = 3;
         let mut moves = 0;
         let mut current = self.phi_norm2();
         let nv = self.tree.vertices.len();

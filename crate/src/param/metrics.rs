@@ -23,6 +23,9 @@ pub struct Metrics {
     pub max_distortion: f64,
     /// Triangles with signed UV area ≤ 0.
     pub flipped: usize,
+    /// Interior vertices around which the map winds more than once (UV angle
+    /// sum off the cone angle by more than pi) although no triangle flips.
+    pub wound_vertices: usize,
     /// Largest deviation (radians) of a seam edge's transition from a multiple of 90°.
     pub seam_angle_residual: f64,
     /// Largest relative difference of the two UV lengths of a seam edge.
@@ -170,6 +173,12 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
             alignment = alignment.max(axis_deviation(ang));
         }
     }
+    let cone_angle = super::seamless::interior_cone_angles(mesh, placement);
+    let wound_vertices = uv_angle_sums(mesh, uv)
+        .iter()
+        .zip(&cone_angle)
+        .filter(|(sum, expected)| expected.is_finite() && (*sum - *expected).abs() > std::f64::consts::PI)
+        .count();
     Metrics {
         distortion: mean(scale),
         scale,
@@ -177,6 +186,7 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
         fraction_below_0_3: per_tri.iter().filter(|&&d| d < 0.3).count() as f64 / n,
         max_distortion: per_tri.iter().cloned().fold(0.0, f64::max),
         flipped,
+        wound_vertices,
         seam_angle_residual: seam_angle,
         seam_length_residual: seam_len,
         alignment_residual: alignment,

@@ -147,6 +147,44 @@ fn flipped_faces(sys: &System, uv: &[[f64; 2]]) -> Vec<usize> {
         .collect()
 }
 
+/// Cone angle `2 pi - k pi/2` of every interior vertex of `mesh` that is not
+/// on a feature (NaN elsewhere), from the cone placement.
+pub(crate) fn interior_cone_angles(mesh: &TriMesh, placement: &ConePlacement) -> Vec<f64> {
+    let mut angle = vec![f64::NAN; mesh.n_vertices()];
+    let cut = &placement.cut;
+    for (cv, &v) in cut.original_vertex.iter().enumerate() {
+        if !cut.mesh.is_boundary_vertex(cv as u32) {
+            angle[v as usize] = 2.0 * std::f64::consts::PI - placement.k[cv] as f64 * std::f64::consts::FRAC_PI_2;
+        }
+    }
+    angle
+}
+
+/// Flipped faces plus the faces around interior vertices whose UV angle sum
+/// is off their cone angle by more than pi: the map winds around such a
+/// vertex more than once although no triangle is flipped.
+fn folded_faces(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]], cone_angle: &[f64]) -> Vec<usize> {
+    let mut bad = flipped_faces(sys, uv);
+    let mut sums = vec![0.0; mesh.n_vertices()];
+    for (f, tri) in mesh.faces().iter().enumerate() {
+        let w = sys.elements[f].w;
+        for k in 0..3 {
+            let (p, a, b) = (uv[w[k]], uv[w[(k + 1) % 3]], uv[w[(k + 2) % 3]]);
+            let (x, y) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
+            sums[tri[k] as usize] += (x[0] * y[1] - x[1] * y[0]).atan2(x[0] * y[0] + x[1] * y[1]).abs();
+        }
+    }
+    for v in 0..mesh.n_vertices() as u32 {
+        let expected = cone_angle[v as usize];
+        if expected.is_finite() && (sums[v as usize] - expected).abs() > std::f64::consts::PI {
+            bad.extend(mesh.vertex_faces(v).map(|f| f as usize));
+        }
+    }
+    bad.sort_unstable();
+    bad.dedup();
+    bad
+}
+
 /// Builds the constrained system, runs Poisson (23), ARAP and the repair.
 ///
 /// Contract: returns UV per wedge of `cut` satisfying every constraint row
@@ -156,7 +194,7 @@ fn flipped_faces(sys: &System, uv: &[[f64; 2]]) -> Vec<usize> {
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     mesh: &TriMesh,
-    _placement: &ConePlacement,
+    placement: &ConePlacement,
     field: &CrossField,
     cut: &CutGraph,
     options: &ParamOptions,
@@ -210,7 +248,8 @@ pub fn solve(
 
     // Fold-over repair: raise the weight of flipped triangles and their
     // neighbours (keeps every constraint: only A changes), re-run ARAP.
-    let mut flips = flipped_faces(&sys, &uv);
+    let cone_angle = interior_cone_angles(mesh, placement);
+    let mut flips = folded_faces(mesh, &sys, &uv, &cone_angle);
     let flips_before = flips.len();
     let (mut best_uv, mut best_flips) = (uv.clone(), flips.len());
     let mut round = 0;
@@ -235,7 +274,7 @@ pub fn solve(
         sys.refactor(&weights)?;
         let (_, e) = arap(&sys, &weights, &pinned, &mut r, &mut uv, options, 10, &mut |_| {})?;
         energy = e;
-        flips = flipped_faces(&sys, &uv);
+        flips = folded_faces(mesh, &sys, &uv, &cone_angle);
         if flips.len() < best_flips {
             best_flips = flips.len();
             best_uv = uv.clone();
@@ -253,7 +292,7 @@ pub fn solve(
             let mut trial = uv.clone();
             let mut r_trial = r.clone();
             let (_, e) = arap(&sys, &weights, &pinned, &mut r_trial, &mut trial, options, 10, &mut |_| {})?;
-            if !flipped_faces(&sys, &trial).is_empty() {
+            if !folded_faces(mesh, &sys, &trial, &cone_angle).is_empty() {
                 break;
             }
             uv = trial;
