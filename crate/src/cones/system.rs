@@ -479,12 +479,12 @@ impl<'a> ComponentSystem<'a> {
     /// Cone-location optimization (section 5.3): moves an interior cone to
     /// a neighbouring interior vertex when that lowers `phiᵀ M phi / A`,
     /// until no move helps or `max_passes` passes. Candidates are ranked by
-    /// the first-order change ([`Self::move_potential`]) and the most
-    /// promising one per cone is are evaluated exactly; after the first pass only
+    /// the first-order change ([`Self::move_potential`]) and the two most
+    /// promising per cone are evaluated exactly; after the first pass only
     /// cones within two rings of a moved cone are reconsidered. Returns the
     /// moves made.
     pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
-        const EXACT_TRIES: usize = 3;
+        const EXACT_TRIES: usize = 2;
         let mut moves = 0;
         let mut current = self.phi_norm2();
         let nv = self.tree.vertices.len();
