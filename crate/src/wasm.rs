@@ -137,7 +137,7 @@ impl MeshSession {
         let (mesh, features, options) = self.request(feature_edges, alpha_smooth, miq)?;
         let mut report = |p: Progress| {
             let (stage, a, b) = cone_stage(&p);
-            let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
+            notify(progress, stage, a, b);
         };
         let r = cones::place_cones(mesh, &features, &options, &mut report).map_err(|e| JsError::new(&e.to_string()))?;
         Ok(cone_result(&r, features.len())?.into())
@@ -171,7 +171,7 @@ impl MeshSession {
                     ParamProgress::Repair { round, flips } => ("repair", round, flips),
                 },
             };
-            let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
+            notify(progress, stage, a, b);
         };
         let sol = pipeline::solve(mesh, &features, &options, &mut report).map_err(|e| JsError::new(&e.to_string()))?;
         let out = cone_result(&sol.placement, sol.features.len())?;
@@ -234,6 +234,12 @@ impl MeshSession {
         }
         Ok(set)
     }
+}
+
+/// Calls the page's `progress(stage, step, remaining)`; a throwing callback
+/// must not stop the solve, so its error is ignored.
+fn notify(progress: &Function, stage: &str, a: usize, b: usize) {
+    let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
 }
 
 /// Stage name and two counters of a cone-placement progress report.

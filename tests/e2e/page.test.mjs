@@ -6,20 +6,15 @@ import os from 'node:os';
 import fs from 'node:fs';
 import path from 'node:path';
 import { after, before, describe, it } from 'node:test';
-import { fileURLToPath } from 'node:url';
-import { launchChromium } from '../../scripts/lib/chromium.mjs';
-import { startServer } from '../../scripts/serve.mjs';
+import { closePage, openPage, output, root } from './harness.mjs';
 
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const dist = path.join(root, 'dist');
-const output = path.join(root, 'tests/output');
 const fandiskObj = path.join(root, 'web/public/samples/fandisk.obj');
 const LOAD_TIMEOUT = 90_000;
 
+let ctx;
 let server;
-let browser;
 let page;
-const consoleErrors = [];
+let consoleErrors = [];
 
 /** Waits until the load counter passes `after` and returns the page's test hooks. */
 async function waitForLoad(afterCount) {
@@ -70,21 +65,11 @@ async function dropFiles(files) {
 
 describe('conemap page', () => {
   before(async () => {
-    assert.ok(fs.existsSync(path.join(dist, 'index.html')), 'dist/ is missing: run `npm run build` first');
-    fs.mkdirSync(output, { recursive: true });
-    server = await startServer({ root: dist, port: 0 });
-    browser = await launchChromium();
-    page = await browser.context.newPage();
-    page.on('console', (msg) => {
-      if (msg.type() === 'error') consoleErrors.push(`console.error: ${msg.text()}`);
-    });
-    page.on('pageerror', (err) => consoleErrors.push(`pageerror: ${err.message}`));
+    ctx = await openPage();
+    ({ server, page, consoleErrors } = ctx);
   });
 
-  after(async () => {
-    await browser?.close();
-    await server?.close();
-  });
+  after(() => closePage(ctx));
 
   it('opens with the fandisk loaded and drawn', async () => {
     await page.goto(server.url);

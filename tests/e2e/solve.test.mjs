@@ -4,22 +4,17 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import { after, before, describe, it } from 'node:test';
-import { fileURLToPath } from 'node:url';
-import { launchChromium } from '../../scripts/lib/chromium.mjs';
-import { startServer } from '../../scripts/serve.mjs';
+import { closePage, openPage, output, root } from './harness.mjs';
 import validator from 'gltf-validator';
 import { checkUv, edgeAlignment, parseObj } from '../node/uvcheck.mjs';
 
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const dist = path.join(root, 'dist');
-const output = path.join(root, 'tests/output');
 const LOAD_TIMEOUT = 90_000;
 const SOLVE_TIMEOUT = 120_000;
 
+let ctx;
 let server;
-let browser;
 let page;
-const consoleErrors = [];
+let consoleErrors = [];
 
 const hooks = () => page.evaluate(() => window.__conemap);
 const featureCountText = async () => Number((await page.getByTestId('feature-count').innerText()).replace(/,/g, ''));
@@ -67,21 +62,11 @@ async function sampleOptions() {
 
 describe('feature editing and solving', () => {
   before(async () => {
-    assert.ok(fs.existsSync(path.join(dist, 'index.html')), 'dist/ is missing: run `npm run build` first');
-    fs.mkdirSync(output, { recursive: true });
-    server = await startServer({ root: dist, port: 0 });
-    browser = await launchChromium();
-    page = await browser.context.newPage();
-    page.on('console', (msg) => {
-      if (msg.type() === 'error') consoleErrors.push(`console.error: ${msg.text()}`);
-    });
-    page.on('pageerror', (err) => consoleErrors.push(`pageerror: ${err.message}`));
+    ctx = await openPage();
+    ({ server, page, consoleErrors } = ctx);
   });
 
-  after(async () => {
-    await browser?.close();
-    await server?.close();
-  });
+  after(() => closePage(ctx));
 
   it('opens with the fandisk and no features', async () => {
     await page.goto(server.url);
