@@ -269,21 +269,29 @@ function wasmNodeCones(ctx) {
   }
 }
 
+/** The built page served from dist/ in headless Chromium, the default mesh loaded. */
+async function openBenchPage() {
+  const { findChromium, launchChromium } = await import('./lib/chromium.mjs');
+  if (!findChromium()) return { skipped: 'no Chromium (set CHROMIUM_PATH or apt-get install chromium)' };
+  const { startServer } = await import('./serve.mjs');
+  const server = await startServer({ root: path.join(root, 'dist'), port: 0 });
+  const browser = await launchChromium();
+  const page = await browser.context.newPage();
+  await page.goto(server.url);
+  await page.waitForFunction(() => window.__conemap?.state === 'ready', null, { timeout: 120_000 });
+  return { server, browser, page };
+}
+
 /**
  * The page's feature editor and solve on the main thread's clock: edge picking
  * (raycast without BVH + nearest side in screen space) and a sharp-edge pass on a
  * 207 k-face mesh, and Run (cone placement) on the fandisk.
  */
 async function browserFeatures(ctx) {
-  const { findChromium, launchChromium } = await import('./lib/chromium.mjs');
-  if (!findChromium()) return { skipped: 'no Chromium (set CHROMIUM_PATH or apt-get install chromium)' };
-  const { startServer } = await import('./serve.mjs');
-  const server = await startServer({ root: path.join(root, 'dist'), port: 0 });
-  const browser = await launchChromium();
+  const opened = await openBenchPage();
+  if (opened.skipped) return opened;
+  const { server, browser, page } = opened;
   try {
-    const page = await browser.context.newPage();
-    await page.goto(server.url);
-    await page.waitForFunction(() => window.__conemap?.state === 'ready', null, { timeout: 120_000 });
     const rows = [];
     // Run on the fandisk: sharp edges > 60° as features, α = 1.
     await page.getByTestId('sharp-toggle').check();
@@ -328,15 +336,10 @@ async function browserFeatures(ctx) {
 async function browserLoad(ctx) {
   const big = ctx.inputs.find((i) => i.faces >= MIN_BIG_FACES);
   if (!big) return { skipped: 'no ≥1 M-face input (--quick)' };
-  const { findChromium, launchChromium } = await import('./lib/chromium.mjs');
-  if (!findChromium()) return { skipped: 'no Chromium (set CHROMIUM_PATH or apt-get install chromium)' };
-  const { startServer } = await import('./serve.mjs');
-  const server = await startServer({ root: path.join(root, 'dist'), port: 0 });
-  const browser = await launchChromium();
+  const opened = await openBenchPage();
+  if (opened.skipped) return opened;
+  const { server, browser, page } = opened;
   try {
-    const page = await browser.context.newPage();
-    await page.goto(server.url);
-    await page.waitForFunction(() => window.__conemap?.state === 'ready', null, { timeout: 120_000 });
     // Two loads of the big file: first with the canvas hidden, so the frame gaps
     // measure the page's own main-thread work (read, worker round trip, geometry
     // upload); then visible, which adds software-GL (SwiftShader) rasterisation of
