@@ -1,50 +1,39 @@
 //! glTF import: hand-built `.glb` / `.gltf` files, malformed input that must
 //! fail cleanly, and a round trip of the shared OBJ meshes through GLB.
 
+use conemap::export::{pack_glb, GltfBuffer};
 use conemap::io::gltf::{import, import_with_source};
 use conemap::io::InputFile;
 use conemap::{ImportError, RawMesh};
 use serde_json::{json, Value};
 
 // ---------------------------------------------------------------------------
-// A tiny glTF writer
+// A tiny glTF writer on the library's buffer builder
 // ---------------------------------------------------------------------------
 
-/// Binary data plus the bufferViews and accessors that describe it (all in buffer 0).
-#[derive(Default)]
-struct Bin {
-    data: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+type Bin = GltfBuffer;
+
+/// The accessors and documents these tests build on a [`GltfBuffer`].
+trait TestGltf {
+    /// An f32 VEC3 accessor of `pts` with min/max; returns its index.
+    fn positions(&mut self, pts: &[[f32; 3]]) -> usize;
+    /// A SCALAR u8 index accessor; returns its index.
+    fn indices_u8(&mut self, idx: &[u8]) -> usize;
+    /// A SCALAR u16 index accessor; returns its index.
+    fn indices_u16(&mut self, idx: &[u16]) -> usize;
+    /// A SCALAR u32 index accessor; returns its index.
+    fn indices_u32(&mut self, idx: &[u32]) -> usize;
+    /// The glTF JSON: `rest` (meshes, nodes, scenes, …) plus asset, buffer,
+    /// bufferViews and accessors. `uri` is the buffer's URI (None for GLB).
+    fn json(&mut self, uri: Option<&str>, rest: Value) -> Value;
+    /// The GLB of [`TestGltf::json`] without a URI and the buffer's bytes.
+    fn glb(&mut self, rest: Value) -> Vec<u8>;
 }
 
-impl Bin {
-    fn align(&mut self) {
-        while !self.data.len().is_multiple_of(4) {
-            self.data.push(0);
-        }
-    }
-
-    /// Appends raw bytes as a new bufferView; returns its index.
-    fn view(&mut self, bytes: &[u8], stride: Option<usize>) -> usize {
-        self.align();
-        let mut v = json!({"buffer": 0, "byteOffset": self.data.len(), "byteLength": bytes.len()});
-        if let Some(s) = stride {
-            v["byteStride"] = json!(s);
-        }
-        self.data.extend_from_slice(bytes);
-        self.views.push(v);
-        self.views.len() - 1
-    }
-
-    fn accessor(&mut self, a: Value) -> usize {
-        self.accessors.push(a);
-        self.accessors.len() - 1
-    }
-
+impl TestGltf for GltfBuffer {
     fn positions(&mut self, pts: &[[f32; 3]]) -> usize {
         let bytes: Vec<u8> = pts.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
-        let view = self.view(&bytes, None);
+        let view = self.view(&bytes, None, None);
         let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
         for p in pts {
             for k in 0..3 {
@@ -59,26 +48,24 @@ impl Bin {
     }
 
     fn indices_u8(&mut self, idx: &[u8]) -> usize {
-        let view = self.view(idx, None);
+        let view = self.view(idx, None, None);
         self.accessor(json!({"bufferView": view, "componentType": 5121, "count": idx.len(), "type": "SCALAR"}))
     }
 
     fn indices_u16(&mut self, idx: &[u16]) -> usize {
         let bytes: Vec<u8> = idx.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let view = self.view(&bytes, None);
+        let view = self.view(&bytes, None, None);
         self.accessor(json!({"bufferView": view, "componentType": 5123, "count": idx.len(), "type": "SCALAR"}))
     }
 
     fn indices_u32(&mut self, idx: &[u32]) -> usize {
         let bytes: Vec<u8> = idx.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let view = self.view(&bytes, None);
+        let view = self.view(&bytes, None, None);
         self.accessor(json!({"bufferView": view, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}))
     }
 
-    /// The glTF JSON: `rest` (meshes, nodes, scenes, …) plus asset, buffer,
-    /// bufferViews and accessors. `uri` is the buffer's URI (None for GLB).
     fn json(&mut self, uri: Option<&str>, rest: Value) -> Value {
-        self.align();
+        self.pad();
         let mut buffer = json!({"byteLength": self.data.len()});
         if let Some(u) = uri {
             buffer["uri"] = json!(u);
@@ -101,30 +88,9 @@ impl Bin {
     }
 }
 
-/// Packs a GLB container: header, JSON chunk (space padded), BIN chunk (zero padded, omitted if empty).
+/// The library's GLB container of `json` and `bin`, without a BIN chunk when `bin` is empty.
 fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
-    let mut j = json.as_bytes().to_vec();
-    while !j.len().is_multiple_of(4) {
-        j.push(b' ');
-    }
-    let mut b = bin.to_vec();
-    while !b.len().is_multiple_of(4) {
-        b.push(0);
-    }
-    let total = 12 + 8 + j.len() + if b.is_empty() { 0 } else { 8 + b.len() };
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((j.len() as u32).to_le_bytes());
-    out.extend(0x4E4F_534Au32.to_le_bytes());
-    out.extend(j);
-    if !b.is_empty() {
-        out.extend((b.len() as u32).to_le_bytes());
-        out.extend(0x004E_4942u32.to_le_bytes());
-        out.extend(b);
-    }
-    out
+    pack_glb(json.as_bytes(), Some(bin).filter(|b| !b.is_empty()))
 }
 
 fn file(name: &str, bytes: Vec<u8>) -> InputFile {
@@ -583,7 +549,7 @@ fn interleaved_stride() {
             bytes.extend(c.to_le_bytes());
         }
     }
-    let view = b.view(&bytes, Some(24));
+    let view = b.view(&bytes, None, Some(24));
     let pos = b.accessor(json!({"bufferView": view, "byteOffset": 0, "componentType": 5126, "count": 4, "type": "VEC3",
                                 "min": [0,0,0], "max": [1,1,0]}));
     let nrm = b.accessor(json!({"bufferView": view, "byteOffset": 12, "componentType": 5126, "count": 4, "type": "VEC3"}));
@@ -596,7 +562,7 @@ fn interleaved_stride() {
 
     // A stride smaller than the element is malformed.
     let mut b = Bin::default();
-    let view = b.view(&bytes, Some(8));
+    let view = b.view(&bytes, None, Some(8));
     let pos =
         b.accessor(json!({"bufferView": view, "componentType": 5126, "count": 4, "type": "VEC3"}));
     let d = malformed_detail(import_glb(
@@ -617,10 +583,10 @@ fn quantized_positions() {
         .flatten()
         .flat_map(|c| c.to_le_bytes())
         .collect();
-    let view = b.view(&q, Some(8));
+    let view = b.view(&q, None, Some(8));
     let pos = b.accessor(json!({"bufferView": view, "componentType": 5122, "normalized": true, "count": 3, "type": "VEC3",
                                 "min": [0,-1,-1], "max": [1,0,0]}));
-    let u8s = b.view(&[1, 2, 3, 0, 4, 5, 6, 0, 7, 8, 9, 0], Some(4));
+    let u8s = b.view(&[1, 2, 3, 0, 4, 5, 6, 0, 7, 8, 9, 0], None, Some(4));
     let pos2 =
         b.accessor(json!({"bufferView": u8s, "componentType": 5121, "count": 3, "type": "VEC3"}));
     let doc = json!({
@@ -648,13 +614,13 @@ fn sparse_positions() {
     let mut b = Bin::default();
     let base = b.positions(&[[0.0; 3]; 3]);
     let base_view = b.accessors[base]["bufferView"].clone();
-    let si = b.view(&[2u8, 0, 0, 0], None);
+    let si = b.view(&[2u8, 0, 0, 0], None, None);
     let vals: Vec<u8> = [[7.0f32, 8.0, 9.0]]
         .iter()
         .flatten()
         .flat_map(|c| c.to_le_bytes())
         .collect();
-    let sv = b.view(&vals, None);
+    let sv = b.view(&vals, None, None);
     let sparse = json!({"count": 1, "indices": {"bufferView": si, "componentType": 5121},
                         "values": {"bufferView": sv}});
     let with_base = b.accessor(
@@ -674,8 +640,8 @@ fn sparse_positions() {
 
     // A sparse index past the accessor count.
     let mut b = Bin::default();
-    let si = b.view(&[5u8, 0, 0, 0], None);
-    let sv = b.view(&vals, None);
+    let si = b.view(&[5u8, 0, 0, 0], None, None);
+    let sv = b.view(&vals, None, None);
     let bad = b.accessor(json!({"componentType": 5126, "count": 3, "type": "VEC3",
         "sparse": {"count": 1, "indices": {"bufferView": si, "componentType": 5121}, "values": {"bufferView": sv}}}));
     let d = malformed_detail(import_glb(
@@ -1154,8 +1120,8 @@ fn hostile_json_numbers_never_panic() {
     let mut b = Bin::default();
     let pos = b.positions(&QUAD);
     let idx = b.indices_u16(&[0, 1, 2, 0, 2, 3]);
-    let si = b.view(&[1u8, 0, 0, 0], None);
-    let sv = b.view(&[0u8; 12], None);
+    let si = b.view(&[1u8, 0, 0, 0], None, None);
+    let sv = b.view(&[0u8; 12], None, None);
     let sparse = b.accessor(json!({"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
         "sparse": {"count": 1, "indices": {"bufferView": si, "componentType": 5121}, "values": {"bufferView": sv}}}));
     let doc = b.json(None, json!({

@@ -9,26 +9,37 @@ import { UvView } from './uvview';
 import { COLORS, type SurfaceMode, type Viewer, heat } from './viewer';
 import { Cancelled, type MeshWorker } from './worker-client';
 
+/** The test hooks the editor keeps up to date (part of `window.__conemap`, see main.ts). */
 export interface EditorHooks {
-  state: string;
+  /** Marked feature edges (without the fixed boundary edges). */
   features: number;
-  result: {
-    cones: number;
-    plus: number;
-    minus: number;
-    sumConeK: number;
-    sumCornerK: number;
-    boundaryCorners: number;
-    eulerCharacteristic: number;
-    rounds: number;
-    featureEdges: number;
-    shownCones: string;
-    uv: boolean;
-    seams: number;
-  } | null;
+  /** Figures of the last finished solve (null before one, or after a new mesh). */
+  result: ResultHook | null;
+  /** Message of the last failed solve (null after a successful one). */
   solveError: string | null;
+  /** Increments on every finished solve (success, failure or cancel). */
   solves: number;
+  /** Face highlighted in the 3D and UV views (hover sync), or null. */
   hoverFace: number | null;
+}
+
+/** Figures of a finished solve, as the tests read them. */
+export interface ResultHook {
+  cones: number;
+  plus: number;
+  minus: number;
+  /** Σk over cones and over boundary corners. */
+  sumConeK: number;
+  sumCornerK: number;
+  boundaryCorners: number;
+  /** χ of the whole mesh (from the import report). */
+  eulerCharacteristic: number;
+  rounds: number;
+  featureEdges: number;
+  /** The cone count as shown in the results panel. */
+  shownCones: string;
+  uv: boolean;
+  seams: number;
 }
 
 const $ = <T extends HTMLElement>(id: string): T => {

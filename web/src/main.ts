@@ -9,8 +9,8 @@ import { MeshWorker } from './worker-client';
 
 type State = 'idle' | 'loading' | 'ready' | 'error' | 'solving' | 'solved';
 
-/** Test hooks (read by tests/e2e and scripts/bench.mjs). */
-interface Hooks {
+/** Test hooks (read by tests/e2e and scripts/bench.mjs); the editor keeps its part up to date. */
+interface Hooks extends EditorHooks {
   state: State;
   stats: (Omit<Stats, 'report'> & Partial<NonNullable<Stats['report']>>) | null;
   lastError: string | null;
@@ -20,33 +20,6 @@ interface Hooks {
   loads: number;
   /** Milliseconds of the last load's phases on the main thread's clock. */
   timings: { read: number; worker: number; draw: number } | null;
-  /** Marked feature edges (without the fixed boundary edges). */
-  features: number;
-  /** Figures of the last finished solve (null before one, or after a new mesh). */
-  result: ResultHook | null;
-  /** Message of the last failed solve (null after a successful one). */
-  solveError: string | null;
-  /** Increments on every finished solve (success, failure or cancel). */
-  solves: number;
-  /** Face highlighted in the 3D and UV views (hover sync), or null. */
-  hoverFace: number | null;
-}
-export interface ResultHook {
-  cones: number;
-  plus: number;
-  minus: number;
-  /** Σk over cones and over boundary corners. */
-  sumConeK: number;
-  sumCornerK: number;
-  boundaryCorners: number;
-  /** χ of the whole mesh (from the import report). */
-  eulerCharacteristic: number;
-  rounds: number;
-  featureEdges: number;
-  /** The cone count as shown in the results panel. */
-  shownCones: string;
-  uv: boolean;
-  seams: number;
 }
 declare global {
   interface Window {
@@ -76,7 +49,7 @@ document.body.dataset['state'] = hooks.state;
 const panels = new Panels();
 const viewer = new Viewer(document.getElementById('viewport')!);
 const worker = new MeshWorker();
-const editor = new Editor(viewer, worker, hooks as unknown as EditorHooks, setState);
+const editor = new Editor(viewer, worker, hooks, setState);
 
 const stageText: Record<Stage, string> = {
   starting: 'Starting the importer',

@@ -3,7 +3,7 @@
 // known, with the hovered face highlighted in sync with the 3D view.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { checkerTexture, checkerUv } from './viewer';
+import { checkerTexture, checkerUv, createRenderer, frameScheduler } from './viewer';
 
 export class UvView {
   private readonly renderer: THREE.WebGLRenderer;
@@ -16,17 +16,13 @@ export class UvView {
   private seams: THREE.LineSegments | null = null;
   private checker: THREE.Texture | null = null;
   private uv: Float32Array | null = null;
-  private frameRequested = false;
   private readonly raycaster = new THREE.Raycaster();
   private bounds = new THREE.Box2();
   /** Called with the face under the pointer (null when none). */
   onHover: ((face: number | null) => void) | null = null;
 
   constructor(private readonly container: HTMLElement) {
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
-    this.renderer.domElement.dataset['testid'] = 'uv-canvas';
-    container.appendChild(this.renderer.domElement);
+    this.renderer = createRenderer(container, 'uv-canvas');
     this.scene.background = new THREE.Color(0x20252d);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.enableRotate = false;
@@ -193,14 +189,8 @@ export class UvView {
     this.requestRender();
   }
 
-  requestRender(): void {
-    if (this.frameRequested) return;
-    this.frameRequested = true;
-    requestAnimationFrame(() => {
-      this.frameRequested = false;
-      this.renderer.render(this.scene, this.camera);
-    });
-  }
+  /** Renders at the next animation frame (once, however often it is called before then). */
+  readonly requestRender = frameScheduler(() => this.renderNow());
 
   renderNow(): void {
     this.renderer.render(this.scene, this.camera);

@@ -79,6 +79,28 @@ export function checkerUv(uv: Float32Array): Float32Array {
   return scaled;
 }
 
+/** A WebGL renderer (antialiased, drawing buffer kept for screenshots, pixel ratio ≤ 2) whose canvas, with `data-testid` = `testid`, is appended to `container`. */
+export function createRenderer(container: HTMLElement, testid: string): THREE.WebGLRenderer {
+  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+  renderer.domElement.dataset['testid'] = testid;
+  container.appendChild(renderer.domElement);
+  return renderer;
+}
+
+/** Wraps `draw` so that any number of calls within one frame run it once, at the next animation frame. */
+export function frameScheduler(draw: () => void): () => void {
+  let requested = false;
+  return () => {
+    if (requested) return;
+    requested = true;
+    requestAnimationFrame(() => {
+      requested = false;
+      draw();
+    });
+  };
+}
+
 export interface Pick {
   face: number;
   /** Nearest of the face's 3 sides in screen space (0..2) and its distance in CSS px. */
@@ -100,7 +122,6 @@ export class Viewer {
   private data: MeshData | null = null;
   private wire: THREE.LineSegments | null = null;
   private wireVisible = true;
-  private frameRequested = false;
   private readonly lines = new Map<string, LineSegments2>();
   private readonly lineMaterials: LineMaterial[] = [];
   private markers = new THREE.Group();
@@ -114,10 +135,7 @@ export class Viewer {
   onRender: (() => void) | null = null;
 
   constructor(private readonly container: HTMLElement) {
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
-    this.renderer.domElement.dataset['testid'] = 'canvas';
-    container.appendChild(this.renderer.domElement);
+    this.renderer = createRenderer(container, 'canvas');
 
     this.scene.background = new THREE.Color(0x2b313b);
     this.scene.add(new THREE.HemisphereLight(0xf2f5ff, 0x3a3f48, 1.6));
@@ -468,14 +486,8 @@ export class Viewer {
     this.requestRender();
   }
 
-  requestRender(): void {
-    if (this.frameRequested) return;
-    this.frameRequested = true;
-    requestAnimationFrame(() => {
-      this.frameRequested = false;
-      this.renderNow();
-    });
-  }
+  /** Renders at the next animation frame (once, however often it is called before then). */
+  readonly requestRender = frameScheduler(() => this.renderNow());
 
   /** Renders now (used before screenshots and after loading, so "ready" means drawn). */
   renderNow(): void {

@@ -17,7 +17,7 @@
 use super::dual_tree::DualTree;
 use super::frames::{vertex_cycle, Frames, Visit};
 use super::harmonic::HarmonicBasis;
-use crate::linalg::{Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
+use crate::linalg::{FixBorder, Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
 use crate::mesh::{TriMesh, NONE};
 use crate::vec3;
 use std::f64::consts::FRAC_PI_2;
@@ -31,6 +31,12 @@ const P_PROXIMAL: f64 = 1e-8;
 pub const MERGE_TOLERANCE: f64 = 0.01;
 /// Total rounding allowed per batch (Algorithm 1: below 0.5).
 const ROUNDING_BATCH: f64 = 0.5;
+/// Memory budget (in f64s) for the cached columns of the bordered updates.
+const BORDER_BUDGET: usize = 8 << 20;
+/// Most fixes handled by bordered updates before the KKT is refactorized.
+const MAX_BORDER: usize = 48;
+/// Largest relative LDLᵀ regularization tried before a solve failure is reported.
+const MAX_DELTA: f64 = 1e-4;
 
 /// One vertex's cycle expressed in the path basis.
 #[derive(Clone, Debug)]
@@ -72,6 +78,11 @@ pub struct ComponentSystem<'a> {
     solver: LdltSolver,
     /// Slot of each fix row's coefficient `t_e` in the KKT values.
     fix_slots: Vec<usize>,
+    /// Slot of each fix row's diagonal (`-1` while the row is inactive, so
+    /// its multiplier is decoupled; `0` once active).
+    fix_diag_slots: Vec<usize>,
+    /// Fixes made since the last factorization, solved by bordering.
+    border: FixBorder,
     h_scale: f64,
     /// Last solution.
     pub x: Vec<f64>,
@@ -284,9 +295,9 @@ impl<'a> ComponentSystem<'a> {
         let fix_slots = (0..ng)
             .map(|g| kkt.pattern.slot(p0 + g, n + row_fix + g).expect("fix entry is in the pattern"))
             .collect();
+        let fix_diag_slots = (0..ng).map(|g| kkt.pattern.diag_slot(n + row_fix + g)).collect();
         let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs)?;
         solver.set_options(SolverOptions { max_refinement_steps: 50, ..SolverOptions::default() });
-        solver.factorize(&kkt.values)?;
         Ok(ComponentSystem {
             mesh,
             tree,
@@ -303,6 +314,8 @@ impl<'a> ComponentSystem<'a> {
             kkt,
             solver,
             fix_slots,
+            fix_diag_slots,
+            border: FixBorder::default(),
             h_scale,
             x: Vec::new(),
             residual: f64::NAN,
@@ -320,21 +333,93 @@ impl<'a> ComponentSystem<'a> {
     fn refactor_and_solve(&mut self) -> Result<(), ConeError> {
         for (g, fx) in self.fixed.iter().enumerate() {
             self.kkt.values[self.fix_slots[g]] = if fx.is_some() { 1.0 } else { 0.0 };
+            self.kkt.values[self.fix_diag_slots[g]] = if fx.is_some() { 0.0 } else { -1.0 };
             self.constraint_rhs[self.row_fix + g] = fx.unwrap_or(0) as f64;
         }
-        self.solver.factorize(&self.kkt.values)?;
-        self.solve()
+        // Escalating regularization: a pivot that overflows under the default
+        // delta (seen on 200 k-face meshes) is retried with a larger one;
+        // iterative refinement against the exact matrix restores accuracy.
+        loop {
+            self.border.clear();
+            let result = self.solver.factorize(&self.kkt.values).map_err(ConeError::from).and_then(|()| self.solve());
+            let options = self.solver.options();
+            match result {
+                Err(ConeError::Solve(
+                    SolveError::ZeroPivot { .. } | SolveError::NotFinite { .. } | SolveError::NotConverged { .. },
+                )) if options.delta < MAX_DELTA => {
+                    self.solver.set_options(SolverOptions { delta: options.delta * 100.0, ..options });
+                }
+                other => return other,
+            }
+        }
     }
 
-    /// Solves with the current factorization and right-hand side.
+    /// Solves with the current factorization (and the bordered fixes made
+    /// since) and right-hand side, refining against the exact matrix.
     pub(crate) fn solve(&mut self) -> Result<(), ConeError> {
         let mut b = vec![0.0; self.n];
         b.extend_from_slice(&self.constraint_rhs);
-        let (x, info) = self.solver.solve_with_info(&b)?;
-        self.refinement_steps += info.refinement_steps;
-        self.x = x;
-        self.residual = info.relative_residual;
+        if self.border.is_empty() {
+            let (x, info) = self.solver.solve_with_info(&b)?;
+            self.refinement_steps += info.refinement_steps;
+            self.x = x;
+            self.residual = info.relative_residual;
+            return Ok(());
+        }
+        let options = self.solver.options();
+        // The outer refinement below runs against the exact matrix; the
+        // inner solves with the stale factor need no refinement of their own.
+        self.solver.set_options(SolverOptions { max_refinement_steps: 0, accept_residual: f64::INFINITY, ..options });
+        let result = self.bordered_solve(&b, options);
+        self.solver.set_options(options);
+        result?;
+        if self.residual > options.accept_residual {
+            return self.refactor_and_solve();
+        }
         Ok(())
+    }
+
+    /// [`Self::solve`] with bordered fixes: iterative refinement of the
+    /// bordered solve against the exact matrix, up to `options`' limits.
+    fn bordered_solve(&mut self, b: &[f64], options: SolverOptions) -> Result<(), ConeError> {
+        let bnorm = b.iter().map(|v| v * v).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
+        let mut x = self.border.solve(&self.solver, b)?;
+        let mut kx = vec![0.0; b.len()];
+        for step in 0..=options.max_refinement_steps {
+            self.kkt.pattern.mul_vec(&self.kkt.values, &x, &mut kx)?;
+            let r: Vec<f64> = b.iter().zip(&kx).map(|(bi, ki)| bi - ki).collect();
+            self.residual = r.iter().map(|v| v * v).sum::<f64>().sqrt() / bnorm;
+            if self.residual < options.tolerance || step == options.max_refinement_steps {
+                break;
+            }
+            let dx = self.border.solve(&self.solver, &r)?;
+            x.iter_mut().zip(&dx).for_each(|(xi, di)| *xi += di);
+            self.refinement_steps += 1;
+        }
+        self.x = x;
+        Ok(())
+    }
+
+    /// Makes the fixes of `newly` (indices into `p`) active: by bordered
+    /// updates while they are few, else by refactorizing; then solves.
+    fn activate_and_solve(&mut self, newly: &[usize]) -> Result<(), ConeError> {
+        for &g in newly {
+            let fx = self.fixed[g].expect("activated fixes have values");
+            self.kkt.values[self.fix_slots[g]] = 1.0;
+            self.kkt.values[self.fix_diag_slots[g]] = 0.0;
+            self.constraint_rhs[self.row_fix + g] = fx as f64;
+        }
+        let limit = MAX_BORDER.min(BORDER_BUDGET / self.kkt.pattern.dim().max(1));
+        if self.border.len() + newly.len() > limit {
+            return self.refactor_and_solve();
+        }
+        let (p0, fix0) = (self.p0(), self.n + self.row_fix);
+        let options = self.solver.options();
+        self.solver.set_options(SolverOptions { max_refinement_steps: 0, accept_residual: f64::INFINITY, ..options });
+        let pushed: Result<(), SolveError> = newly.iter().try_for_each(|&g| self.border.push(&self.solver, p0 + g, fix0 + g));
+        self.solver.set_options(options);
+        pushed?;
+        self.solve()
     }
 
     /// Algorithm 1: solve, fix the batch of free `p` nearest to integers
@@ -356,19 +441,23 @@ impl<'a> ComponentSystem<'a> {
                 .collect();
             progress(self.rounds, free.len());
             if free.is_empty() {
-                return Ok(());
+                // Later stages change only right-hand sides: start them from
+                // a factorization of the final matrix.
+                return if self.border.is_empty() { Ok(()) } else { self.refactor_and_solve() };
             }
             free.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut total = 0.0;
+            let mut batch = Vec::new();
             for (i, &(d, g)) in free.iter().enumerate() {
                 if i > 0 && total + d >= ROUNDING_BATCH {
                     break;
                 }
                 total += d;
                 self.fixed[g] = Some(self.x[p0 + g].round() as i64);
+                batch.push(g);
             }
             self.rounds += 1;
-            self.refactor_and_solve()?;
+            self.activate_and_solve(&batch)?;
         }
     }
 

@@ -21,11 +21,21 @@ const UNSIGNED_INT: u32 = 5125;
 /// The binary glTF (`.glb`) of `input`.
 pub fn write_glb(input: &ExportInput, options: &ExportOptions) -> Vec<u8> {
     let (doc, bin) = document(input, options, false);
-    let mut json = serde_json::to_vec(&doc).expect("glTF JSON serialises");
-    while !json.len().is_multiple_of(4) {
-        json.push(b' ');
-    }
-    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let json = serde_json::to_vec(&doc).expect("glTF JSON serialises");
+    pack_glb(&json, Some(&bin))
+}
+
+/// A GLB container: the 12-byte header, the JSON chunk (padded with spaces to
+/// 4 bytes) and, unless `bin` is `None`, the BIN chunk (padded with zeros).
+pub fn pack_glb(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
+    let padded = |bytes: &[u8], fill: u8| {
+        let mut v = bytes.to_vec();
+        v.resize(bytes.len().next_multiple_of(4), fill);
+        v
+    };
+    let json = padded(json, b' ');
+    let bin = bin.map(|b| padded(b, 0));
+    let total = 12 + 8 + json.len() + bin.as_ref().map_or(0, |b| 8 + b.len());
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());
@@ -33,9 +43,11 @@ pub fn write_glb(input: &ExportInput, options: &ExportOptions) -> Vec<u8> {
     out.extend_from_slice(&(json.len() as u32).to_le_bytes());
     out.extend_from_slice(b"JSON");
     out.extend_from_slice(&json);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
+    if let Some(bin) = bin {
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+    }
     out
 }
 
@@ -45,33 +57,51 @@ pub fn write_gltf(input: &ExportInput, options: &ExportOptions) -> String {
     serde_json::to_string(&doc).expect("glTF JSON serialises")
 }
 
-/// Binary data with its bufferViews and accessors (all in buffer 0).
+/// A glTF binary buffer under construction: its bytes and the bufferViews and
+/// accessors that describe them (all in buffer 0).
 #[derive(Default)]
-struct Bin {
-    data: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+pub struct GltfBuffer {
+    /// The buffer's bytes.
+    pub data: Vec<u8>,
+    /// The `bufferViews` JSON objects, by index.
+    pub views: Vec<Value>,
+    /// The `accessors` JSON objects, by index.
+    pub accessors: Vec<Value>,
 }
 
-impl Bin {
-    fn pad(&mut self) {
+impl GltfBuffer {
+    /// Pads `data` with zeros to a multiple of 4 bytes.
+    pub fn pad(&mut self) {
         while !self.data.len().is_multiple_of(4) {
             self.data.push(0);
         }
     }
-    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+
+    /// Appends `bytes` at the next 4-byte boundary as a new bufferView with
+    /// the given `target` and `byteStride` (each only if `Some`); returns its index.
+    pub fn view(&mut self, bytes: &[u8], target: Option<u32>, stride: Option<usize>) -> usize {
         self.pad();
         let mut v = json!({"buffer": 0, "byteOffset": self.data.len(), "byteLength": bytes.len()});
         if let Some(t) = target {
             v["target"] = json!(t);
         }
+        if let Some(s) = stride {
+            v["byteStride"] = json!(s);
+        }
         self.data.extend_from_slice(bytes);
         self.views.push(v);
         self.views.len() - 1
     }
+
+    /// Appends the accessor JSON object `a`; returns its index.
+    pub fn accessor(&mut self, a: Value) -> usize {
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
     fn floats<const N: usize>(&mut self, values: &[[f32; N]], with_bounds: bool) -> usize {
         let bytes: Vec<u8> = values.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
-        let view = self.view(&bytes, Some(ARRAY_BUFFER));
+        let view = self.view(&bytes, Some(ARRAY_BUFFER), None);
         let kind = match N {
             2 => "VEC2",
             3 => "VEC3",
@@ -91,8 +121,7 @@ impl Bin {
             a["min"] = json!(lo.map(f64::from).to_vec());
             a["max"] = json!(hi.map(f64::from).to_vec());
         }
-        self.accessors.push(a);
-        self.accessors.len() - 1
+        self.accessor(a)
     }
     fn indices(&mut self, triangles: &[[u32; 3]], vertex_count: usize) -> usize {
         // 65535 is the primitive restart value for u16, so it must not occur.
@@ -101,11 +130,10 @@ impl Bin {
         } else {
             (triangles.iter().flatten().flat_map(|&i| i.to_le_bytes()).collect(), UNSIGNED_INT)
         };
-        let view = self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER));
-        self.accessors.push(json!({
+        let view = self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER), None);
+        self.accessor(json!({
             "bufferView": view, "componentType": component, "count": 3 * triangles.len(), "type": "SCALAR"
-        }));
-        self.accessors.len() - 1
+        }))
     }
 }
 
@@ -115,7 +143,7 @@ fn document(input: &ExportInput, options: &ExportOptions, embed: bool) -> (Value
     let layout = input.layout();
     let normals = input.normals();
     let norm = UvNormalization::of(input.uv);
-    let mut bin = Bin::default();
+    let mut bin = GltfBuffer::default();
 
     // Materials: the source's (factors only), plus a checker material for
     // primitives without one when the checker is on.
@@ -124,7 +152,7 @@ fn document(input: &ExportInput, options: &ExportOptions, embed: bool) -> (Value
     let mut images = Vec::new();
     if options.checker {
         let png = super::checker_png();
-        let view = bin.view(&png, None);
+        let view = bin.view(&png, None, None);
         images.push(json!({"bufferView": view, "mimeType": "image/png", "name": "conemap checker"}));
         let cell = options.checker_cell.filter(|c| *c > 0.0 && c.is_finite()).unwrap_or_else(|| norm.auto_checker_cell());
         // Texture coordinate T = (u, −v) / (2 cell) in input UV units: the

@@ -50,7 +50,7 @@ mod obj;
 mod png;
 mod source;
 
-pub use glb::{write_glb, write_gltf};
+pub use glb::{pack_glb, write_glb, write_gltf, GltfBuffer};
 pub use obj::write_obj;
 pub use png::checker_png;
 

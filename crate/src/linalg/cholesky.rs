@@ -4,6 +4,7 @@
 //! and solves followed by iterative refinement against the unregularized
 //! matrix.
 
+use std::marker::PhantomData;
 use std::sync::Mutex;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -314,6 +315,21 @@ impl Core {
     }
 }
 
+/// A sparse symmetric solver: the symbolic analysis (AMD ordering) of one
+/// pattern, the numeric factorization of its latest values, and solves with
+/// iterative refinement against the unregularized matrix. `K` picks the
+/// factorization; use it as [`LdltSolver`] or [`SparseSpd`].
+pub struct SparseCholesky<K> {
+    core: Core,
+    kind: PhantomData<K>,
+}
+
+/// Marker for [`LdltSolver`]: LDLᵀ with sign-based dynamic regularization.
+pub enum Ldlt {}
+
+/// Marker for [`SparseSpd`]: LLᵀ without regularization.
+pub enum Llt {}
+
 /// Sparse symmetric *indefinite* solver for saddle-point/KKT systems
 /// `[[A, Cᵀ], [C, 0]]`: LDLᵀ with sign-based dynamic regularization and
 /// iterative refinement against the unregularized matrix.  Reuses one
@@ -325,11 +341,13 @@ impl Core {
 /// is the unique solution and the multipliers are one valid choice (the
 /// multiplier null-space component is arbitrary).  If it is inconsistent the
 /// residual stalls and the solve returns [`SolveError::NotConverged`].
-pub struct LdltSolver {
-    core: Core,
-}
+pub type LdltSolver = SparseCholesky<Ldlt>;
 
-impl LdltSolver {
+/// Sparse Cholesky (LLᵀ, no regularization) for symmetric positive definite
+/// systems, e.g. a Poisson or ARAP global step: factor once, solve many.
+pub type SparseSpd = SparseCholesky<Llt>;
+
+impl SparseCholesky<Ldlt> {
     /// Symbolic analysis for `pattern`. `signs[i]` is the expected pivot sign
     /// of row `i`: `+1` for primal rows, `−1` for constraint rows (`0`: only
     /// regularize pivots below `epsilon` in magnitude). Errors on bad lengths/signs.
@@ -344,7 +362,7 @@ impl LdltSolver {
         if let Some((index, &sign)) = signs.iter().enumerate().find(|(_, s)| !(-1..=1).contains(*s)) {
             return Err(SolveError::InvalidSign { index, sign });
         }
-        Ok(Self { core: Core::new(Kind::Ldlt, pattern, signs.to_vec())? })
+        Ok(Self { core: Core::new(Kind::Ldlt, pattern, signs.to_vec())?, kind: PhantomData })
     }
 
     /// Like [`Self::new`] with non-default [`SolverOptions`].
@@ -362,19 +380,41 @@ impl LdltSolver {
     pub fn options(&self) -> SolverOptions {
         self.core.options
     }
+}
 
-    /// Replaces the options (takes effect at the next factorize/solve).
-    pub fn set_options(&mut self, options: SolverOptions) {
-        self.core.options = options;
+impl SparseCholesky<Llt> {
+    /// Symbolic analysis (AMD ordering) for `pattern`.
+    pub fn new(pattern: &SymmetricPattern) -> Result<Self, SolveError> {
+        let n = pattern.dim();
+        Ok(Self { core: Core::new(Kind::Llt, pattern, vec![1; n])?, kind: PhantomData })
     }
 
+    /// Builds the pattern from `triplets` (upper or full), analyses and factorizes.
+    pub fn from_triplets(n: usize, triplets: &[Triplet]) -> Result<Self, SolveError> {
+        let (pattern, values) = SymmetricPattern::with_values(n, triplets)?;
+        let mut s = Self::new(&pattern)?;
+        s.factorize(&values)?;
+        Ok(s)
+    }
+}
+
+impl<K> SparseCholesky<K> {
     /// The pattern the solver was analysed for.
     pub fn pattern(&self) -> &SymmetricPattern {
         &self.core.pattern
     }
 
-    /// Numeric LDLᵀ of the matrix with upper-triangle `values` in slot order
-    /// (length `pattern.nnz()`); reuses the symbolic analysis.
+    /// Replaces the options (takes effect at the next factorize/solve;
+    /// `delta`/`epsilon` are unused for LLᵀ).
+    pub fn set_options(&mut self, options: SolverOptions) {
+        self.core.options = options;
+    }
+
+    /// Numeric factorization of the matrix with upper-triangle `values` in
+    /// slot order (length `pattern.nnz()`); reuses the symbolic analysis.
+    /// LLᵀ gives [`SolveError::NotPositiveDefinite`] if a pivot is ≤ 0 (a
+    /// singular PSD matrix may instead pass with a tiny pivot and then fail to
+    /// converge in [`Self::solve`]).
     pub fn factorize(&mut self, values: &[f64]) -> Result<(), SolveError> {
         self.core.factorize(values)
     }
@@ -399,67 +439,6 @@ impl LdltSolver {
 
     /// Solves for `k` right-hand sides stored column-major in `rhs`
     /// (`n·k` values) with one blocked triangular solve per refinement step.
-    pub fn solve_many(&self, rhs: &[f64], k: usize) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
-        self.core.solve_many(rhs, k)
-    }
-}
-
-/// Sparse Cholesky (LLᵀ, no regularization) for symmetric positive definite
-/// systems, e.g. a Poisson or ARAP global step: factor once, solve many.
-pub struct SparseSpd {
-    core: Core,
-}
-
-impl SparseSpd {
-    /// Symbolic analysis (AMD ordering) for `pattern`.
-    pub fn new(pattern: &SymmetricPattern) -> Result<Self, SolveError> {
-        let n = pattern.dim();
-        Ok(Self { core: Core::new(Kind::Llt, pattern, vec![1; n])? })
-    }
-
-    /// Builds the pattern from `triplets` (upper or full), analyses and factorizes.
-    pub fn from_triplets(n: usize, triplets: &[Triplet]) -> Result<Self, SolveError> {
-        let (pattern, values) = SymmetricPattern::with_values(n, triplets)?;
-        let mut s = Self::new(&pattern)?;
-        s.factorize(&values)?;
-        Ok(s)
-    }
-
-    /// The pattern the solver was analysed for.
-    pub fn pattern(&self) -> &SymmetricPattern {
-        &self.core.pattern
-    }
-
-    /// Sets refinement options (`delta`/`epsilon` are unused for LLᵀ).
-    pub fn set_options(&mut self, options: SolverOptions) {
-        self.core.options = options;
-    }
-
-    /// Numeric LLᵀ of the values (slot order); [`SolveError::NotPositiveDefinite`]
-    /// if a pivot is ≤ 0 (a singular PSD matrix may instead pass with a tiny
-    /// pivot and then fail to converge in [`Self::solve`]).
-    pub fn factorize(&mut self, values: &[f64]) -> Result<(), SolveError> {
-        self.core.factorize(values)
-    }
-
-    /// [`Self::factorize`] from triplets.
-    pub fn factorize_triplets(&mut self, triplets: &[Triplet]) -> Result<(), SolveError> {
-        let v = self.core.pattern.values_from_triplets(triplets)?;
-        self.core.factorize(&v)
-    }
-
-    /// Solves `A x = rhs` with iterative refinement (see [`LdltSolver::solve`]).
-    pub fn solve(&self, rhs: &[f64]) -> Result<Vec<f64>, SolveError> {
-        self.solve_with_info(rhs).map(|(x, _)| x)
-    }
-
-    /// [`Self::solve`] also returning the achieved residual.
-    pub fn solve_with_info(&self, rhs: &[f64]) -> Result<(Vec<f64>, SolveInfo), SolveError> {
-        let (x, info) = self.core.solve_many(rhs, 1)?;
-        Ok((x, info[0]))
-    }
-
-    /// Solves `k` column-major right-hand sides at once.
     pub fn solve_many(&self, rhs: &[f64], k: usize) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
         self.core.solve_many(rhs, k)
     }

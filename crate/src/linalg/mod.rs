@@ -8,12 +8,14 @@
 //!   LDLᵀ (faer, AMD ordering, no pivoting) with sign-based dynamic
 //!   regularization (`+1` primal, `−1` constraint rows), then iterative
 //!   refinement against the unregularized matrix.
-//! * [`SparseSpd`] — plain sparse Cholesky LLᵀ for SPD systems.
+//! * [`SparseSpd`] — plain sparse Cholesky LLᵀ for SPD systems. Both
+//!   solvers are [`SparseCholesky`] and share its factorize/solve methods.
 //! * [`Kkt`] / [`solve_kkt`] — KKT assembly and a one-off solve.
 //!
 //! Everything runs sequentially (`Par::Seq`) and never reads the clock, so it
 //! works on `wasm32-unknown-unknown`.  Failures are [`SolveError`]s, not panics.
 
+mod bordered;
 mod cholesky;
 mod kkt;
 mod pattern;
@@ -21,7 +23,8 @@ mod pattern;
 #[cfg(test)]
 mod tests;
 
-pub use cholesky::{LdltSolver, SolveInfo, SolverOptions, SparseSpd};
+pub use bordered::FixBorder;
+pub use cholesky::{Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
 pub use kkt::{solve_kkt, Kkt, KktSolution};
 pub use pattern::{SymmetricPattern, Triplet, IGNORED_SLOT};
 
