@@ -2,7 +2,7 @@
 // Benchmark harness: prints a table and writes bench-results/bench.json.
 //
 //   npm run bench                     (setup + build + this script)
-//   node scripts/bench.mjs [--no-native] [--no-browser] [--quick]
+//   node scripts/bench.mjs [--no-native] [--no-browser] [--quick] [--only ENV:STAGE,...]
 //
 // Each entry of BENCHES is { env, stage, run(ctx) } and returns rows
 // { input, faces?, ms, runs?, note? } (env/stage are filled in). Later pipeline
@@ -21,6 +21,9 @@ import { fileURLToPath } from 'node:url';
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const args = new Set(process.argv.slice(2));
 const quick = args.has('--quick');
+// --only native:solve,browser:solve-big runs just those benches.
+const onlyAt = process.argv.indexOf('--only');
+const only = onlyAt > 0 ? new Set((process.argv[onlyAt + 1] ?? '').split(',')) : null;
 const MIN_BIG_FACES = 1_000_000;
 const env = { ...process.env, PATH: [path.join(os.homedir(), '.cargo/bin'), process.env.PATH].join(path.delimiter) };
 
@@ -333,6 +336,68 @@ async function browserFeatures(ctx) {
   }
 }
 
+/** Sum of the proportional set sizes (PSS, MB) of all running Chromium processes. */
+function chromiumPssMb() {
+  let kb = 0;
+  for (const pid of fs.readdirSync('/proc').filter((d) => /^\d+$/.test(d))) {
+    try {
+      if (!/chrom/.test(fs.readFileSync(`/proc/${pid}/comm`, 'utf8'))) continue;
+      const m = /^Pss:\s+(\d+) kB/m.exec(fs.readFileSync(`/proc/${pid}/smaps_rollup`, 'utf8'));
+      if (m) kb += Number(m[1]);
+    } catch { /* the process ended */ }
+  }
+  return kb / 1024;
+}
+
+/**
+ * The whole method in the page's worker on the fandisk subdivided to 207 k
+ * faces (sharp edges > 60° as features, α = 0.01): wall time from Run to the
+ * result shown, the longest main-thread frame gap meanwhile, and the peak
+ * memory of Chromium (PSS of all its processes, sampled every 250 ms).
+ */
+async function browserSolveBig(ctx) {
+  const opened = await openBenchPage();
+  if (opened.skipped) return opened;
+  const { server, browser, page } = opened;
+  let peak = chromiumPssMb();
+  const sampler = setInterval(() => { peak = Math.max(peak, chromiumPssMb()); }, 250);
+  try {
+    const mid = subObj(ctx.inputs[0].file, 2);
+    const input = path.basename(mid.file);
+    const loads = await page.evaluate(() => window.__conemap.loads);
+    await page.getByTestId('file-input').setInputFiles(mid.file);
+    await page.waitForFunction((k) => window.__conemap.loads > k && window.__conemap.state !== 'loading', loads, { timeout: 300_000 });
+    await page.getByTestId('sharp-toggle').check();
+    await page.getByTestId('sharp-angle').fill('60');
+    await page.waitForFunction(() => window.__conemap.features > 0, null, { timeout: 120_000 });
+    // α slider is log10 α in [-3, 2].
+    await page.getByTestId('alpha').fill('-2');
+    await page.evaluate(() => {
+      const m = { maxGap: 0, running: true };
+      window.__bench = m;
+      let last = performance.now();
+      const tick = (t) => { m.maxGap = Math.max(m.maxGap, t - last); last = t; if (m.running) requestAnimationFrame(tick); };
+      requestAnimationFrame(tick);
+    });
+    const solves = await page.evaluate(() => window.__conemap.solves);
+    const t0 = Date.now();
+    await page.getByTestId('run').click();
+    await page.waitForFunction((k) => window.__conemap.solves > k, solves, { timeout: 1_800_000, polling: 500 });
+    const ms = Date.now() - t0;
+    const h = await page.evaluate(() => { window.__bench.running = false; return { result: window.__conemap.result, error: window.__conemap.solveError, gap: window.__bench.maxGap }; });
+    const note = h.result ? `${h.result.cones} cones, ${h.result.uv ? 'UVs' : 'no UVs'}` : `failed: ${h.error}`;
+    return [
+      { stage: 'Run → result shown (207 k faces, worker)', input, faces: mid.faces, ms, note },
+      { stage: 'longest frame gap during the solve', input, ms: h.gap, note: 'main thread stays responsive' },
+      { stage: 'peak Chromium memory (PSS, MB)', input, ms: NaN, note: `${peak.toFixed(0)} MB over the load and solve` },
+    ];
+  } finally {
+    clearInterval(sampler);
+    await browser.close();
+    await server.close();
+  }
+}
+
 async function browserLoad(ctx) {
   const big = ctx.inputs.find((i) => i.faces >= MIN_BIG_FACES);
   if (!big) return { skipped: 'no ≥1 M-face input (--quick)' };
@@ -415,6 +480,7 @@ const BENCHES = [
   { env: 'wasm-node', stage: 'solve', run: wasmNodeSolve, enabled: true },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },
+  { env: 'browser', stage: 'solve-big', run: browserSolveBig, enabled: !args.has('--no-browser') && !quick },
 ];
 
 // ---------------------------------------------------------------- main
@@ -425,7 +491,7 @@ if (!quick) inputs.push(bigObj(fandisk));
 
 const rows = [];
 const notes = [];
-for (const b of BENCHES.filter((x) => x.enabled)) {
+for (const b of BENCHES.filter((x) => x.enabled && (!only || only.has(`${x.env}:${x.stage}`)))) {
   process.stdout.write(`bench: ${b.env} ${b.stage}… `);
   const t0 = performance.now();
   let result;

@@ -128,3 +128,41 @@ fn bff_punctured_torus() {
 fn bff_hemisphere() {
     run("bff-hemisphere.obj", None, 0.5, 0.0);
 }
+
+/// A closed cylinder whose caps are triangle fans: with the rims as features
+/// each cap's only interior vertex would need a cone of index 4 (angle 0).
+fn fan_capped_cylinder(n: usize) -> TriMesh {
+    let mut positions = Vec::new();
+    for y in [-1.0, 1.0] {
+        for i in 0..n {
+            let t = 2.0 * PI * i as f64 / n as f64;
+            positions.push([t.cos(), y, t.sin()]);
+        }
+    }
+    positions.push([0.0, -1.0, 0.0]);
+    positions.push([0.0, 1.0, 0.0]);
+    let (bottom, top) = ((2 * n) as u32, (2 * n + 1) as u32);
+    let mut triangles = Vec::new();
+    for i in 0..n as u32 {
+        let j = (i + 1) % n as u32;
+        let (a, b, c, d) = (i, j, n as u32 + j, n as u32 + i);
+        triangles.push([a, c, b]);
+        triangles.push([a, d, c]);
+        triangles.push([a, b, bottom]);
+        triangles.push([d, top, c]);
+    }
+    TriMesh::from_welded_arrays(positions, triangles).expect("valid cylinder")
+}
+
+#[test]
+fn a_zero_angle_cone_is_a_clear_error_and_without_features_the_cylinder_solves() {
+    let mesh = fan_capped_cylinder(32);
+    assert_eq!(mesh.euler_characteristic(), 2);
+    let options = SolveOptions { cones: ConeOptions::default(), param: ParamOptions::default() };
+    let err = solve(&mesh, &FeatureSet::sharp_edges(&mesh, 40.0), &options, &mut |_| {}).err().expect("no seamless map exists");
+    let text = err.to_string();
+    assert!(text.contains("index 4") && text.contains("subdivide"), "{text}");
+    let none = FeatureSet::none(&mesh);
+    let solution = solve(&mesh, &none, &options, &mut |_| {}).expect("solves without features");
+    assert_eq!(solution.param.metrics.flipped, 0);
+}

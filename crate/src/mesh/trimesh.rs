@@ -10,8 +10,8 @@
 //! * every halfedge has a twin; edge `e` is `{h, twin(h)}` with
 //!   `h = edge_halfedges(e)[0]` a face halfedge.
 
-use super::validate::{analyze_welded, Analysis};
-use super::weld::{weld, Welded};
+use super::validate::{analyze_raw, analyze_welded, Analysis};
+use super::weld::Welded;
 use super::{MeshReport, RawMesh};
 use crate::Problem;
 
@@ -45,7 +45,7 @@ impl TriMesh {
     /// Errs with every blocking problem ([`Problem::is_blocking`]);
     /// unreferenced vertices are dropped silently.
     pub fn from_raw(raw: &RawMesh) -> Result<TriMesh, Vec<Problem>> {
-        Self::from_analysis(analyze_welded(raw, weld(raw)))
+        Self::from_analysis(analyze_raw(raw))
     }
 
     /// Builds from arrays whose indices already define connectivity (no

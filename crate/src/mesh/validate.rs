@@ -16,7 +16,7 @@
 //!   non-manifold vertex and counts towards each component's V).
 
 use super::topology::{he_head, he_tail, EdgeTable, UnionFind};
-use super::weld::{weld, Welded, NO_VERTEX};
+use super::weld::{close_cracks, weld, Welded, NO_VERTEX};
 use super::{MeshReport, RawMesh};
 use crate::Problem;
 
@@ -28,7 +28,32 @@ pub const ZERO_AREA_REL: f64 = 1e-12;
 /// Never panics: out-of-range indices, NaN coordinates and empty meshes are
 /// reported, not fatal.
 pub fn analyze(raw: &RawMesh) -> MeshReport {
-    analyze_welded(raw, weld(raw)).report
+    analyze_raw(raw).report
+}
+
+/// Welds `raw` by position, closes floating-point cracks along open
+/// boundaries ([`super::weld::close_cracks`]) and analyses the result.
+pub(crate) fn analyze_raw(raw: &RawMesh) -> Analysis {
+    let a = analyze_welded(raw, weld(raw));
+    if a.report.boundary_edges == 0 {
+        return a;
+    }
+    let boundary_edges: Vec<[u32; 2]> = (0..a.edges.n_edges())
+        .filter(|&e| a.edges.start[e + 1] - a.edges.start[e] == 1)
+        .map(|e| a.edges.verts[e])
+        .collect();
+    let mut on_boundary = vec![false; a.welded.positions.len()];
+    for e in &boundary_edges {
+        on_boundary[e[0] as usize] = true;
+        on_boundary[e[1] as usize] = true;
+    }
+    let boundary: Vec<u32> = boundary_edges.iter().flatten().copied().collect();
+    let joined: std::collections::HashSet<[u32; 2]> =
+        a.edges.verts.iter().filter(|e| on_boundary[e[0] as usize] && on_boundary[e[1] as usize]).copied().collect();
+    match close_cracks(&a.welded, &boundary, |u, v| joined.contains(&[u.min(v), u.max(v)])) {
+        Some(closed) => analyze_welded(raw, closed),
+        None => a,
+    }
 }
 
 /// Like [`analyze`], but connectivity comes from the file's indices as given

@@ -83,6 +83,76 @@ fn weld_impl(raw: &RawMesh, merge_positions: bool) -> Welded {
     Welded { positions, triangles, source_to_welded, welded_to_source }
 }
 
+/// Distance, relative to the bounding-box diagonal, below which two
+/// boundary vertices are one point: exporters that evaluate a seam point
+/// twice in floating point (e.g. angle 0 and 2 pi) leave such cracks.
+pub const CRACK_TOLERANCE: f64 = 1e-7;
+
+/// Closes floating-point cracks: merges each vertex of `boundary` (vertices
+/// on an edge used by one face) into a lower-numbered boundary vertex within
+/// [`CRACK_TOLERANCE`] of the diagonal, unless `joined(u, w)` says an edge
+/// already joins them. Returns `None` when nothing merges.
+pub fn close_cracks(w: &Welded, boundary: &[u32], joined: impl Fn(u32, u32) -> bool) -> Option<Welded> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in &w.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+    let tol = CRACK_TOLERANCE * diag;
+    if !(tol > 0.0 && tol.is_finite()) {
+        return None;
+    }
+    let cell = |p: [f64; 3]| p.map(|x| ((x - 0.0) / tol).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<u32>, BuildHasherDefault<FxHasher>> = HashMap::default();
+    let mut sorted = boundary.to_vec();
+    sorted.sort_unstable();
+    sorted.dedup();
+    let mut rep: Vec<u32> = (0..w.positions.len() as u32).collect();
+    let mut merged = false;
+    for &v in &sorted {
+        let p = w.positions[v as usize];
+        let c = cell(p);
+        let mut target = None;
+        'search: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &u in grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]).into_iter().flatten() {
+                        let q = w.positions[u as usize];
+                        let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
+                        if d2 <= tol * tol && !joined(u, v) {
+                            target = Some(rep[u as usize]);
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+        match target {
+            Some(t) => {
+                rep[v as usize] = t;
+                merged = true;
+            }
+            None => grid.entry(c).or_default().push(v),
+        }
+    }
+    if !merged {
+        return None;
+    }
+    // Renumber by first use, as `weld` does, and compose the source maps.
+    let raw = RawMesh {
+        positions: w.positions.clone(),
+        triangles: w.triangles.iter().map(|t| t.map(|v| if v == NO_VERTEX { v } else { rep[v as usize] })).collect(),
+    };
+    let re = weld_impl(&raw, false);
+    let source_to_welded =
+        w.source_to_welded.iter().map(|&x| if x == NO_VERTEX { x } else { re.source_to_welded[rep[x as usize] as usize] }).collect();
+    let welded_to_source = re.welded_to_source.iter().map(|&x| w.welded_to_source[x as usize]).collect();
+    Some(Welded { positions: re.positions, triangles: re.triangles, source_to_welded, welded_to_source })
+}
+
 /// Exact position key; `x + 0.0` turns -0.0 into +0.0.
 #[derive(Clone, Copy, PartialEq, Eq)]
 struct PosKey([u64; 3]);
@@ -178,5 +248,22 @@ mod tests {
         };
         let w = weld(&raw);
         assert_eq!(w.triangles, vec![[0, 0, 1]]);
+    }
+
+    /// Two triangles whose shared edge was written twice with a 1e-12 crack
+    /// (the way `sin(2 pi)` differs from `sin(0)`): the analysis closes it.
+    #[test]
+    fn floating_point_cracks_close_but_real_gaps_stay() {
+        let crack = |gap: f64| RawMesh {
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0 + gap, 0.0, 0.0], [gap, 1.0, 0.0], [1.0, 1.0, 0.0]],
+            triangles: vec![[0, 1, 2], [3, 5, 4]],
+        };
+        let closed = crate::mesh::analyze(&crack(1e-12));
+        assert_eq!((closed.vertices, closed.boundary_edges), (4, 4), "the crack is closed");
+        let open = crate::mesh::analyze(&crack(1e-3));
+        assert_eq!((open.vertices, open.boundary_edges), (6, 6), "a real gap stays open");
+        let mesh = crate::mesh::TriMesh::from_raw(&crack(1e-12)).unwrap();
+        assert_eq!(mesh.n_vertices(), 4);
+        assert_eq!(mesh.source_to_welded()[3], mesh.source_to_welded()[1]);
     }
 }

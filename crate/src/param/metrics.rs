@@ -101,11 +101,9 @@ fn axis_deviation(angle: f64) -> f64 {
     (angle - (angle / FRAC_PI_2).round() * FRAC_PI_2).abs()
 }
 
-/// Computes every figure of [`Metrics`] for per-corner `uv` (index `3 f + k`).
-pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[[f64; 2]]) -> Metrics {
-    let nf = mesh.n_faces();
-    let jac = face_jacobians(mesh, uv);
-    let parts: Vec<(f64, f64, f64)> = jac
+/// Conformal and anticonformal norms and area of every face with a finite Jacobian.
+fn face_parts(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<(f64, f64, f64)> {
+    face_jacobians(mesh, uv)
         .iter()
         .map(|&(j, area)| {
             let (a, b, c, d) = (j[0][0], j[0][1], j[1][0], j[1][1]);
@@ -114,7 +112,12 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
             (conf, anti, area)
         })
         .filter(|p| p.0.is_finite() && p.1.is_finite())
-        .collect();
+        .collect()
+}
+
+/// Eq. (19) at the best scale: `(mean, s)` minimising the area-weighted mean
+/// of `min_R |s J_f - R|_F` over `s` (golden-section search on `log s`).
+fn best_scale_mean(parts: &[(f64, f64, f64)]) -> (f64, f64) {
     let total: f64 = parts.iter().map(|p| p.2).sum::<f64>().max(f64::MIN_POSITIVE);
     let mean = |s: f64| parts.iter().map(|&(c, a, w)| w * tri_distortion(c, a, s)).sum::<f64>() / total;
     // Least-squares scale as a centre, then golden-section search on log s (the mean is convex in s).
@@ -141,6 +144,20 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
         }
     }
     let scale = (0.5 * (lo + hi)).exp();
+    (mean(scale), scale)
+}
+
+/// The distortion of eq. (19) at the best global scale ([`Metrics::distortion`])
+/// of per-corner `uv` (index `3 f + k`).
+pub fn distortion(mesh: &TriMesh, uv: &[[f64; 2]]) -> f64 {
+    best_scale_mean(&face_parts(mesh, uv)).0
+}
+
+/// Computes every figure of [`Metrics`] for per-corner `uv` (index `3 f + k`).
+pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[[f64; 2]]) -> Metrics {
+    let nf = mesh.n_faces();
+    let parts = face_parts(mesh, uv);
+    let (distortion, scale) = best_scale_mean(&parts);
     let per_tri: Vec<f64> = parts.iter().map(|&(c, a, _)| tri_distortion(c, a, scale)).collect();
     let n = per_tri.len().max(1) as f64;
 
@@ -180,7 +197,7 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
         .filter(|(sum, expected)| expected.is_finite() && (*sum - *expected).abs() > std::f64::consts::PI)
         .count();
     Metrics {
-        distortion: mean(scale),
+        distortion,
         scale,
         fraction_below_0_2: per_tri.iter().filter(|&&d| d < 0.2).count() as f64 / n,
         fraction_below_0_3: per_tri.iter().filter(|&&d| d < 0.3).count() as f64 / n,

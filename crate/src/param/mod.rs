@@ -2,7 +2,8 @@
 //! of B.1 ([`field`]), a cut to a topological disk through every cone
 //! ([`cut_graph`], B step 1), the seamless Poisson solve of eq. (23) followed
 //! by ARAP local/global iterations and a fold-over repair ([`seamless`]),
-//! and the quality figures of section 7 ([`metrics`], eq. 19).
+//! an injective (flip-free) refinement under the same constraints
+//! ([`injective`]), and the quality figures of section 7 ([`metrics`], eq. 19).
 //!
 //! Input: the original [`TriMesh`] and the [`ConePlacement`] computed on it.
 //! Output: one UV per face corner (`3 f + k`), seamless across every seam
@@ -11,6 +12,7 @@
 
 pub mod cut_graph;
 pub mod field;
+pub mod injective;
 pub mod metrics;
 pub mod seamless;
 #[cfg(test)]
@@ -37,13 +39,18 @@ pub struct ParamOptions {
     /// Keep the target rotation of triangles adjacent to features and
     /// boundaries fixed to the field (Appendix B.2, local step).
     pub fix_feature_rotations: bool,
-    /// Rounds of the fold-over repair (local reweighting); 0 disables it.
+    /// Rounds of the fold-over repair (local reweighting) that looks for a
+    /// fold-free start of the refinement; 0 disables it. Without the
+    /// refinement the repaired weights are also relaxed back towards 1.
     pub repair_rounds: usize,
+    /// Injective refinement of the fold-free map ([`injective`]); 0
+    /// iterations disables it.
+    pub refine: injective::RefineOptions,
 }
 
 impl Default for ParamOptions {
     fn default() -> Self {
-        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 12 }
+        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 12, refine: injective::RefineOptions::default() }
     }
 }
 
@@ -67,6 +74,7 @@ pub struct ParamTimings {
     pub poisson: f64,
     pub arap: f64,
     pub repair: f64,
+    pub injective: f64,
     pub metrics: f64,
 }
 
@@ -85,6 +93,8 @@ pub struct Parametrization {
     pub flips_before_repair: usize,
     /// Flipped triangles the repair removed.
     pub flips_fixed: usize,
+    /// Iterations of the injective refinement kept (0: none ran or it was not used).
+    pub refine_iterations: usize,
     pub timings: ParamTimings,
 }
 
@@ -105,6 +115,9 @@ pub enum ParamError {
     UncutSingularity { edge: u32, matching: i64 },
     /// The solve left a constraint row violated by `residual` (relative to the UV extent).
     ConstraintViolation { residual: f64 },
+    /// A cone of index `k >= 4` (cone angle `2 pi - k pi/2 <= 0`) at input vertex `vertex`:
+    /// no seamless map exists with it.
+    DegenerateCone { vertex: u32, k: i32 },
     /// A value became NaN or infinite.
     NotFinite { what: &'static str },
     /// The sparse KKT solve failed.
@@ -130,6 +143,12 @@ impl fmt::Display for ParamError {
             ParamError::ConstraintViolation { residual } => {
                 write!(f, "seam/isoline constraints violated after the solve (relative residual {residual:.2e})")
             }
+            ParamError::DegenerateCone { vertex, k } => write!(
+                f,
+                "the cone at vertex v{vertex} would need index {k} (a cone angle of {}°): the features around it leave no other \
+                 interior vertex to carry the curvature; subdivide the mesh there or mark fewer feature edges",
+                360 - 90 * k
+            ),
             ParamError::NotFinite { what } => write!(f, "{what} is not finite"),
             ParamError::Solve(e) => write!(f, "parametrization solve failed: {e}"),
         }
@@ -185,6 +204,7 @@ pub fn parametrize(
         arap_iterations: result.arap_iterations,
         flips_before_repair: result.flips_before_repair,
         flips_fixed: result.flips_fixed,
+        refine_iterations: result.refine_iterations,
         timings,
     })
 }
@@ -223,6 +243,11 @@ fn check_inputs(mesh: &TriMesh, placement: &ConePlacement) -> Result<(), ParamEr
     }
     if placement.omega.iter().any(|w| !w.is_finite()) {
         return Err(ParamError::NotFinite { what: "omega" });
+    }
+    for (v, &k) in placement.k.iter().enumerate() {
+        if k >= 4 && !cm.is_boundary_vertex(v as u32) {
+            return Err(ParamError::DegenerateCone { vertex: placement.cut.original_vertex[v], k });
+        }
     }
     Ok(())
 }

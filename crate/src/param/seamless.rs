@@ -2,10 +2,15 @@
 //! wedge of the cut disk; the Poisson problem (23) `min sum_f A_f |grad f - R_f|^2`
 //! under the seam, isoline and pin constraints, enforced exactly through one
 //! KKT system; ARAP local/global iterations (eq. 4, Liu et al. 2008) that
-//! reuse its factorization; then a fold-over repair by local reweighting.
+//! reuse its factorization; then, when ARAP folds, a repair by local
+//! reweighting that finds a fold-free map, and finally the injective
+//! refinement of [`super::injective`] (ARAP + barrier, same constraints)
+//! from the best fold-free map, which pulls the distortion back down.
 
 use super::cut_graph::CutGraph;
 use super::field::{CrossField, NO_ISOLINE};
+use super::injective::{RefineOptions, Refiner};
+use super::metrics;
 use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
@@ -19,19 +24,21 @@ pub struct SeamlessResult {
     pub arap_iterations: usize,
     pub flips_before_repair: usize,
     pub flips_fixed: usize,
+    /// Iterations of the injective refinement ([`super::injective`]) kept.
+    pub refine_iterations: usize,
     /// Final ARAP energy `sum_f A_f |J_f - R_f|^2`.
     pub energy: f64,
 }
 
 /// Per-face linear-element data.
-struct Element {
+pub(super) struct Element {
     /// Wedges of the three corners.
-    w: [usize; 3],
+    pub(super) w: [usize; 3],
     /// Unknowns of the corners' u and v.
-    x: [[usize; 3]; 2],
+    pub(super) x: [[usize; 3]; 2],
     /// Gradients of the three hat functions in the face frame.
-    g: [[f64; 2]; 3],
-    area: f64,
+    pub(super) g: [[f64; 2]; 3],
+    pub(super) area: f64,
 }
 
 /// The constrained system on the shared unknowns of [`unknowns`].
@@ -101,6 +108,30 @@ impl System {
         self.kkt.refill(&a, &self.constraints)?;
         self.solver.factorize(&self.kkt.values)?;
         Ok(())
+    }
+
+    /// The unknown vector of wedge UVs `uv` (which must agree on shared unknowns).
+    fn unknowns_of(&self, uv: &[[f64; 2]]) -> Vec<f64> {
+        let mut x = vec![0.0; self.n_unknowns];
+        for (w, p) in uv.iter().enumerate() {
+            x[self.vars[0][w]] = p[0];
+            x[self.vars[1][w]] = p[1];
+        }
+        x
+    }
+
+    /// Wedge UVs of the unknown vector `x`.
+    fn wedges_of(&self, x: &[f64]) -> Vec<[f64; 2]> {
+        (0..self.n_wedges).map(|w| [x[self.vars[0][w]], x[self.vars[1][w]]]).collect()
+    }
+
+    /// Largest `|C x|` over the constraint rows (all homogeneous).
+    fn constraint_residual(&self, x: &[f64]) -> f64 {
+        let mut res = vec![0.0f64; self.n_rows];
+        for &(row, col, v) in &self.constraints {
+            res[row] += v * x[col];
+        }
+        res.iter().fold(0.0f64, |m, v| m.max(v.abs()))
     }
 
     fn jacobian(&self, f: usize, uv: &[[f64; 2]]) -> [[f64; 2]; 2] {
@@ -185,12 +216,16 @@ fn folded_faces(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]], cone_angle: &[f64
     bad
 }
 
-/// Builds the constrained system, runs Poisson (23), ARAP and the repair.
+/// Builds the constrained system, runs Poisson (23), ARAP, the repair (only
+/// when ARAP folds) and the injective refinement.
 ///
 /// Contract: returns UV per wedge of `cut` satisfying every constraint row
 /// (seam transitions along each [`super::cut_graph::SeamCurve`], isolines,
 /// one pin per disk component) to solver accuracy. The KKT matrix is
-/// factored once for Poisson + ARAP; the repair refactors (same pattern).
+/// factored once for Poisson + ARAP; the repair refactors (same pattern);
+/// the refinement has its own pattern (u–v coupling), analysed once. When a
+/// fold-free map (no flipped triangle, no wound vertex) is found the result
+/// is fold-free and no worse by eq. (19) than that map.
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
     mesh: &TriMesh,
@@ -238,6 +273,7 @@ pub fn solve(
     // Poisson (23) with the field's target Jacobians (B.1).
     let mut r: Vec<[[f64; 2]; 2]> = (0..nf).map(|f| field.target(f)).collect();
     let mut uv = sys.solve(&weights, &r)?;
+    let poisson_uv = uv.clone();
     timings.poisson = clock.lap();
 
     let fixed: Vec<bool> = (0..nf)
@@ -254,6 +290,7 @@ pub fn solve(
     let (mut best_uv, mut best_flips) = (uv.clone(), flips.len());
     let mut round = 0;
     let mut pinned = fixed.clone();
+    let relax = options.refine.max_iterations == 0;
     while !flips.is_empty() && round < options.repair_rounds {
         round += 1;
         progress(ParamProgress::Repair { round, flips: flips.len() });
@@ -280,9 +317,9 @@ pub fn solve(
             best_uv = uv.clone();
         }
     }
-    // Relaxation: once fold-free, decay the repair weights back towards 1
-    // (less distortion) for as long as the map stays fold-free.
-    if best_flips == 0 && round > 0 {
+    // Relaxation (only without the injective refinement): once fold-free,
+    // decay the repair weights back towards 1 while the map stays fold-free.
+    if relax && best_flips == 0 && round > 0 {
         uv = best_uv.clone();
         for _ in 0..16 {
             for w in weights.iter_mut() {
@@ -302,13 +339,61 @@ pub fn solve(
         }
     }
     timings.repair = clock.lap();
+
+    // Injective refinement from a fold-free start: ARAP's map, else the
+    // repaired one, else the Poisson map when that one is fold-free.
+    if best_flips > 0 && folded_faces(mesh, &sys, &poisson_uv, &cone_angle).is_empty() {
+        best_uv = poisson_uv;
+        best_flips = 0;
+        energy = arap_energy(&sys, &best_uv);
+    }
+    let mut refine_iterations = 0;
+    if best_flips == 0 && options.refine.max_iterations > 0 {
+        if let Some((x, iterations)) = refine(&sys, &sys.unknowns_of(&best_uv), &options.refine) {
+            let refined = sys.wedges_of(&x);
+            // The refinement minimises a surrogate (ARAP + barrier): keep its
+            // map unless it is worse by the paper's measure, eq. (19).
+            let corners = |uv: &[[f64; 2]]| -> Vec<[f64; 2]> { cut.wedge.iter().map(|&w| uv[w as usize]).collect() };
+            if folded_faces(mesh, &sys, &refined, &cone_angle).is_empty()
+                && metrics::distortion(mesh, &corners(&refined)) <= metrics::distortion(mesh, &corners(&best_uv))
+            {
+                refine_iterations = iterations;
+                energy = arap_energy(&sys, &refined);
+                best_uv = refined;
+            }
+        }
+    }
+    timings.injective = clock.lap();
     Ok(SeamlessResult {
         uv: best_uv,
         arap_iterations: iterations,
         flips_before_repair: flips_before,
         flips_fixed: flips_before - best_flips,
+        refine_iterations,
         energy,
     })
+}
+
+/// Injective refinement ([`super::injective`]) of the feasible, fold-free
+/// unknowns `start`; `None` when it made no progress, failed numerically or
+/// drifted off the constraints (then `start` stands).
+fn refine(sys: &System, start: &[f64], options: &RefineOptions) -> Option<(Vec<f64>, usize)> {
+    let mut refiner = Refiner::new(&sys.elements, sys.n_unknowns, &sys.constraints, sys.n_rows).ok()?;
+    let mut x = start.to_vec();
+    let stats = refiner.refine(&mut x, options);
+    let scale = x.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let drift = sys.constraint_residual(&x) - sys.constraint_residual(start);
+    (stats.iterations > 0 && drift <= 1e-12 * scale).then_some((x, stats.iterations))
+}
+
+/// ARAP energy (4) `sum_f A_f min_R |J_f - R|^2` of the wedge UVs `uv`.
+fn arap_energy(sys: &System, uv: &[[f64; 2]]) -> f64 {
+    (0..sys.elements.len())
+        .map(|f| {
+            let j = sys.jacobian(f, uv);
+            closest_rotation(j).map_or(f64::INFINITY, |r| sys.elements[f].area * frob2(j, r))
+        })
+        .sum()
 }
 
 /// ARAP local/global iterations (eq. 4) from `uv`; `cap` overrides the

@@ -105,3 +105,23 @@ fn ring_with_flap_does_not_collapse_while_miq_emulation_does() {
     assert!(ours_min > 0.05, "our map: smallest area ratio {ours_min}");
     assert!(miq_min < 0.2 * ours_min, "MIQ emulation should collapse the flap: {miq_min} vs {ours_min}");
 }
+
+
+#[test]
+fn folded_arap_map_is_repaired_and_refined_without_flips() {
+    // A square annulus with a rotated hole: ARAP leaves a flipped triangle;
+    // the repaired map is the start of the injective refinement.
+    let mesh = crate::cones::test_meshes::square_annulus(8, 4, 0.4, 0.5);
+    let none = FeatureSet::none(&mesh);
+    let options = ConeOptions { alpha_smooth: 0.01, ..ConeOptions::default() };
+    let placement = place_cones(&mesh, &none, &options, &mut |_| {}).expect("cones");
+    let no_refine = ParamOptions { refine: injective::RefineOptions { max_iterations: 0, ..Default::default() }, ..Default::default() };
+    let before = parametrize(&mesh, &placement, &no_refine, &mut |_| {}).expect("param");
+    let after = parametrize(&mesh, &placement, &ParamOptions::default(), &mut |_| {}).expect("param");
+    assert!(after.flips_before_repair > 0, "the case should start with flips");
+    assert!(after.refine_iterations > 0);
+    check(&mesh, &placement, &after);
+    assert_eq!(after.metrics.wound_vertices, 0);
+    assert!(after.metrics.distortion < before.metrics.distortion, "{} vs {}", after.metrics.distortion, before.metrics.distortion);
+    eprintln!("annulus: distortion {:.4} -> {:.4}", before.metrics.distortion, after.metrics.distortion);
+}
