@@ -36,9 +36,11 @@ pub enum Problem {
 
 impl Problem {
     /// True for defects that make the mesh unusable for parametrization;
-    /// false for those that are only reported (unreferenced vertices are dropped).
+    /// false for those that are only reported and repaired when the mesh is
+    /// built (unreferenced vertices are dropped, a non-manifold vertex is
+    /// split into one vertex per fan).
     pub fn is_blocking(&self) -> bool {
-        !matches!(self, Problem::UnreferencedVertex { .. })
+        !matches!(self, Problem::UnreferencedVertex { .. } | Problem::NonManifoldVertex { .. })
     }
 }
 
@@ -54,7 +56,7 @@ impl fmt::Display for Problem {
                 list("f", faces)
             ),
             Problem::NonManifoldVertex { vertex, fans } => {
-                write!(f, "vertex v{vertex} is non-manifold: its faces form {fans} separate fans")
+                write!(f, "vertex v{vertex} is non-manifold: its faces form {fans} separate fans (split into {fans} vertices)")
             }
             Problem::InconsistentOrientation { edge, faces } => write!(
                 f,

@@ -210,7 +210,9 @@ impl<'a> ExportInput<'a> {
         let s2w = mesh.source_to_welded();
         for (f, (t, w)) in raw.triangles.iter().zip(mesh.faces()).enumerate() {
             for k in 0..3 {
-                if s2w.get(t[k] as usize) != Some(&w[k]) {
+                // A split non-manifold vertex: a copy at the same position.
+                let same = |v: u32| v == w[k] || mesh.position(v) == mesh.position(w[k]);
+                if !s2w.get(t[k] as usize).is_some_and(|&v| same(v)) {
                     return Err(ExportError::CornerMismatch { face: f, corner: k });
                 }
             }

@@ -11,7 +11,7 @@
 //!   `h = edge_halfedges(e)[0]` a face halfedge.
 
 use super::validate::{analyze_raw, analyze_welded, Analysis};
-use super::weld::Welded;
+use super::weld::{split_pinches, Welded};
 use super::{MeshReport, RawMesh};
 use crate::Problem;
 
@@ -45,7 +45,19 @@ impl TriMesh {
     /// Errs with every blocking problem ([`Problem::is_blocking`]);
     /// unreferenced vertices are dropped silently.
     pub fn from_raw(raw: &RawMesh) -> Result<TriMesh, Vec<Problem>> {
-        Self::from_analysis(analyze_raw(raw))
+        let a = analyze_raw(raw);
+        let pinches: Vec<Problem> =
+            a.report.problems.iter().filter(|p| matches!(p, Problem::NonManifoldVertex { .. })).cloned().collect();
+        if pinches.is_empty() || a.report.problems.iter().any(Problem::is_blocking) {
+            return Self::from_analysis(a);
+        }
+        // Repair: one vertex per fan; the report keeps naming the pinches.
+        let vertices: Vec<u32> =
+            pinches.iter().filter_map(|p| if let Problem::NonManifoldVertex { vertex, .. } = p { Some(*vertex) } else { None }).collect();
+        let mut split = analyze_welded(raw, split_pinches(&a.welded, &vertices));
+        split.report.non_manifold_vertices = pinches.len();
+        split.report.problems.extend(pinches);
+        Self::from_analysis(split)
     }
 
     /// Builds from arrays whose indices already define connectivity (no

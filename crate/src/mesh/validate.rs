@@ -410,7 +410,8 @@ pub(crate) fn analyze_welded(raw: &RawMesh, welded: Welded) -> Analysis {
         genus,
         problems,
         source_vertices: n_src,
-        merged_vertices: referenced_sources - nv,
+        // A split pinch vertex adds a vertex without a source of its own.
+        merged_vertices: referenced_sources.saturating_sub(nv),
         edges: ne,
         boundary_edges: nb,
         non_manifold_edges,

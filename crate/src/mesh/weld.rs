@@ -153,6 +153,77 @@ pub fn close_cracks(w: &Welded, boundary: &[u32], joined: impl Fn(u32, u32) -> b
     Some(Welded { positions: re.positions, triangles: re.triangles, source_to_welded, welded_to_source })
 }
 
+/// Splits each vertex of `pinches` whose faces form several fans (faces
+/// around it joined through shared edges) into one vertex per fan: the
+/// first fan in face order keeps the vertex, the others get copies at the
+/// same position (same source vertex). Faces keep their order.
+pub fn split_pinches(w: &Welded, pinches: &[u32]) -> Welded {
+    let mut out = w.clone();
+    let mut is_pinch = vec![false; w.positions.len()];
+    for &v in pinches {
+        is_pinch[v as usize] = true;
+    }
+    let mut incident: HashMap<u32, Vec<usize>, BuildHasherDefault<FxHasher>> = HashMap::default();
+    for (f, t) in w.triangles.iter().enumerate() {
+        for &v in t {
+            if v != NO_VERTEX && is_pinch[v as usize] {
+                incident.entry(v).or_default().push(f);
+            }
+        }
+    }
+    let mut keys: Vec<u32> = incident.keys().copied().collect();
+    keys.sort_unstable();
+    for v in keys {
+        let faces = &incident[&v];
+        // Union faces sharing an edge (v, x).
+        let mut parent: Vec<usize> = (0..faces.len()).collect();
+        fn find(p: &mut [usize], mut i: usize) -> usize {
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        let mut by_other: HashMap<u32, usize, BuildHasherDefault<FxHasher>> = HashMap::default();
+        for (i, &f) in faces.iter().enumerate() {
+            for &x in &w.triangles[f] {
+                if x == v {
+                    continue;
+                }
+                match by_other.get(&x) {
+                    Some(&j) => {
+                        let (a, b) = (find(&mut parent, i), find(&mut parent, j));
+                        parent[a] = b;
+                    }
+                    None => {
+                        by_other.insert(x, i);
+                    }
+                }
+            }
+        }
+        let mut copy_of_root: HashMap<usize, u32, BuildHasherDefault<FxHasher>> = HashMap::default();
+        for (i, &f) in faces.iter().enumerate() {
+            let root = find(&mut parent, i);
+            let next = copy_of_root.len();
+            let id = *copy_of_root.entry(root).or_insert_with(|| {
+                if next == 0 {
+                    v
+                } else {
+                    out.positions.push(w.positions[v as usize]);
+                    out.welded_to_source.push(w.welded_to_source[v as usize]);
+                    (out.positions.len() - 1) as u32
+                }
+            });
+            for c in out.triangles[f].iter_mut() {
+                if *c == v {
+                    *c = id;
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Exact position key; `x + 0.0` turns -0.0 into +0.0.
 #[derive(Clone, Copy, PartialEq, Eq)]
 struct PosKey([u64; 3]);
