@@ -169,6 +169,7 @@ impl MeshSession {
                     ParamProgress::Poisson => ("poisson", 0, 0),
                     ParamProgress::Arap { iteration, max } => ("arap", iteration, max),
                     ParamProgress::Repair { round, flips } => ("repair", round, flips),
+                    ParamProgress::Injective { iteration, max } => ("injective", iteration, max),
                 },
             };
             notify(progress, stage, a, b);

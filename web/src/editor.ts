@@ -358,6 +358,8 @@ export class Editor {
         return [`ARAP iteration ${step + 1}${remaining ? ` of ${fmtInt(remaining)}` : ''}`, remaining ? step / remaining : undefined];
       case 'repair':
         return [`Repairing flipped faces: round ${step + 1} (${fmtInt(remaining)} flipped)`, undefined];
+      case 'injective':
+        return [`Injective refinement: iteration ${step} of at most ${fmtInt(remaining)}`, remaining ? step / remaining : undefined];
       case 'pair cancellation':
         return [`Cancelling cone pairs (${fmtInt(step)} removed)`, undefined];
       default: {

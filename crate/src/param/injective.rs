@@ -232,8 +232,9 @@ impl<'a> Refiner<'a> {
     /// reweighted global steps with flip-free line search, stopping at a
     /// relative decrease below `options.tolerance` or at a numerical failure
     /// (keeping the last iterate). Leaves `x` unchanged when it is not
-    /// fold-free. Every iterate is fold-free and feasible.
-    pub(super) fn refine(&mut self, x: &mut [f64], options: &RefineOptions) -> RefineStats {
+    /// fold-free. Every iterate is fold-free and feasible. `progress(i)` is
+    /// called before iteration `i` (0-based).
+    pub(super) fn refine(&mut self, x: &mut [f64], options: &RefineOptions, progress: &mut dyn FnMut(usize)) -> RefineStats {
         let psi = Density { mu: options.barrier, eps: options.smoothing };
         let mut e = energy(self.elements, x, &psi);
         let mut stats = RefineStats { iterations: 0, energy_start: e, energy: e };
@@ -242,7 +243,8 @@ impl<'a> Refiner<'a> {
         }
         let nf = self.elements.len();
         let mut trial = x.to_vec();
-        for _ in 0..options.max_iterations {
+        for iteration in 0..options.max_iterations {
+            progress(iteration);
             if e <= 0.0 {
                 break;
             }
@@ -456,7 +458,7 @@ mod tests {
         assert!(residual(&c, m, &x) < 1e-15 && min_area(&elements, &x) > 0.0);
         let mut refiner = Refiner::new(&elements, 2 * nv, &c, m).unwrap();
         let options = RefineOptions::default();
-        let stats = refiner.refine(&mut x, &options);
+        let stats = refiner.refine(&mut x, &options, &mut |_| {});
         assert!(stats.iterations > 0 && stats.iterations <= options.max_iterations);
         assert!(stats.energy < 1e-3 * stats.energy_start, "{stats:?}");
         assert!((energy(&elements, &x, &Density { mu: options.barrier, eps: options.smoothing }) - stats.energy).abs() < 1e-12);
@@ -485,7 +487,7 @@ mod tests {
         ] {
             let mut y = x.clone();
             let mut refiner = Refiner::new(&elements, 2 * nv, &c, m).unwrap();
-            let stats = refiner.refine(&mut y, &options);
+            let stats = refiner.refine(&mut y, &options, &mut |_| {});
             assert!(stats.energy < 0.5 * stats.energy_start, "{options:?}: {stats:?}");
             assert!(min_area(&elements, &y) > 0.0 && residual(&c, m, &y) < 1e-13);
         }
@@ -498,7 +500,7 @@ mod tests {
         // The zero map (feasible, every triangle degenerate): not a valid start.
         let mut x = vec![0.0; 2 * nv];
         let mut refiner = Refiner::new(&elements, 2 * nv, &c, m).unwrap();
-        let stats = refiner.refine(&mut x, &RefineOptions::default());
+        let stats = refiner.refine(&mut x, &RefineOptions::default(), &mut |_| {});
         assert_eq!(stats.iterations, 0);
         assert_eq!(stats.energy_start, f64::INFINITY);
         assert!(x.iter().all(|&v| v == 0.0));

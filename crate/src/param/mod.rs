@@ -64,6 +64,8 @@ pub enum ParamProgress {
     Arap { iteration: usize, max: usize },
     /// Fold-over repair round `round`, `flips` flipped triangles before it.
     Repair { round: usize, flips: usize },
+    /// Injective refinement iteration `iteration` (1-based) of at most `max`.
+    Injective { iteration: usize, max: usize },
 }
 
 /// Seconds per stage.

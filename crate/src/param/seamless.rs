@@ -349,7 +349,7 @@ pub fn solve(
     }
     let mut refine_iterations = 0;
     if best_flips == 0 && options.refine.max_iterations > 0 {
-        if let Some((x, iterations)) = refine(&sys, &sys.unknowns_of(&best_uv), &options.refine) {
+        if let Some((x, iterations)) = refine(&sys, &sys.unknowns_of(&best_uv), &options.refine, progress) {
             let refined = sys.wedges_of(&x);
             // The refinement minimises a surrogate (ARAP + barrier): keep its
             // map unless it is worse by the paper's measure, eq. (19).
@@ -377,10 +377,11 @@ pub fn solve(
 /// Injective refinement ([`super::injective`]) of the feasible, fold-free
 /// unknowns `start`; `None` when it made no progress, failed numerically or
 /// drifted off the constraints (then `start` stands).
-fn refine(sys: &System, start: &[f64], options: &RefineOptions) -> Option<(Vec<f64>, usize)> {
+fn refine(sys: &System, start: &[f64], options: &RefineOptions, progress: &mut dyn FnMut(ParamProgress)) -> Option<(Vec<f64>, usize)> {
     let mut refiner = Refiner::new(&sys.elements, sys.n_unknowns, &sys.constraints, sys.n_rows).ok()?;
     let mut x = start.to_vec();
-    let stats = refiner.refine(&mut x, options);
+    let max = options.max_iterations;
+    let stats = refiner.refine(&mut x, options, &mut |iteration| progress(ParamProgress::Injective { iteration: iteration + 1, max }));
     let scale = x.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let drift = sys.constraint_residual(&x) - sys.constraint_residual(start);
     (stats.iterations > 0 && drift <= 1e-12 * scale).then_some((x, stats.iterations))
