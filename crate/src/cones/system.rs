@@ -31,6 +31,8 @@ const P_PROXIMAL: f64 = 1e-8;
 pub const MERGE_TOLERANCE: f64 = 0.01;
 /// Total rounding allowed per batch (Algorithm 1: below 0.5).
 const ROUNDING_BATCH: f64 = 0.5;
+/// Relative residual the solves of intermediate rounding rounds stop at.
+const ROUNDING_TOLERANCE: f64 = 1e-9;
 /// Memory budget (in f64s) for the cached columns of the bordered updates.
 const BORDER_BUDGET: usize = 8 << 20;
 /// Most fixes handled by bordered updates before the KKT is refactorized.
@@ -426,6 +428,25 @@ impl<'a> ComponentSystem<'a> {
     /// (total rounding below 0.5, at least one), repeat until all are fixed.
     /// `progress(round, free_left)` is called after every solve.
     pub fn round_all(&mut self, progress: &mut dyn FnMut(usize, usize)) -> Result<(), ConeError> {
+        // Rounding decisions need far less than the final accuracy: solve
+        // intermediate rounds to ROUNDING_TOLERANCE, the last one exactly.
+        let exact = self.solver.options();
+        self.solver.set_options(SolverOptions { tolerance: ROUNDING_TOLERANCE.max(exact.tolerance), ..exact });
+        let rounded = self.round_loop(progress);
+        let options = self.solver.options();
+        self.solver.set_options(SolverOptions { tolerance: exact.tolerance, ..options });
+        rounded?;
+        // Later stages change only right-hand sides: start them from a
+        // factorization of the final matrix.
+        if self.border.is_empty() {
+            self.solve()
+        } else {
+            self.refactor_and_solve()
+        }
+    }
+
+    /// The rounds of [`Self::round_all`].
+    fn round_loop(&mut self, progress: &mut dyn FnMut(usize, usize)) -> Result<(), ConeError> {
         self.refactor_and_solve()?;
         loop {
             let p0 = self.p0();
@@ -441,9 +462,7 @@ impl<'a> ComponentSystem<'a> {
                 .collect();
             progress(self.rounds, free.len());
             if free.is_empty() {
-                // Later stages change only right-hand sides: start them from
-                // a factorization of the final matrix.
-                return if self.border.is_empty() { Ok(()) } else { self.refactor_and_solve() };
+                return Ok(());
             }
             free.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut total = 0.0;
