@@ -447,3 +447,20 @@ fn gltf_source_keeps_primitives_materials_and_normals() {
     assert!(read.json["materials"][0]["pbrMetallicRoughness"].get("baseColorTexture").is_some());
     assert_eq!(read.json["materials"].as_array().unwrap().len(), 2);
 }
+
+/// Vertices merged across a floating-point crack are written at one
+/// position, so a checker that welds by exact position sees the same mesh.
+#[test]
+fn crack_closed_vertices_are_written_at_one_position() {
+    let gap = 1e-13;
+    let raw = RawMesh {
+        positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0 + gap, 0.0, 0.0], [gap, 1.0, 0.0], [1.0, 1.0, 0.0]],
+        triangles: vec![[0, 1, 2], [3, 5, 4]],
+    };
+    let mesh = TriMesh::from_raw(&raw).unwrap();
+    assert_eq!(mesh.n_vertices(), 4);
+    let uv: Vec<[f64; 2]> = raw.triangles.iter().flatten().map(|&s| [raw.positions[s as usize][0], raw.positions[s as usize][1]]).collect();
+    let text = export::write_obj(&ExportInput::new(&raw, &mesh, &uv).unwrap(), &ExportOptions::default());
+    let positions: HashSet<String> = text.lines().filter(|l| l.starts_with("v ")).map(str::to_string).collect();
+    assert_eq!(positions.len(), 4, "{text}");
+}

@@ -175,7 +175,7 @@ fn document(input: &ExportInput, options: &ExportOptions, embed: bool) -> (Value
     let mut primitives = Vec::new();
     for g in &layout.groups {
         let positions: Vec<[f32; 3]> =
-            g.wedges.iter().map(|w| input.raw.positions[w.source as usize].map(|x| x as f32)).collect();
+            g.wedges.iter().map(|w| input.position(w.source).map(|x| x as f32)).collect();
         let normal: Vec<[f32; 3]> = g.wedges.iter().map(|w| normals[w.source as usize].map(|x| x as f32)).collect();
         let uv: Vec<[f32; 2]> = g.wedges.iter().map(|w| norm.gltf(w.uv).map(|x| x as f32)).collect();
         let p = bin.floats(&positions, true);

@@ -246,6 +246,16 @@ impl<'a> ExportInput<'a> {
         UvNormalization::of(self.uv)
     }
 
+    /// Output position of source vertex `s`: that of its welded vertex, so
+    /// vertices merged across a floating-point crack coincide exactly in the
+    /// file (the raw position when `s` is not in the mesh).
+    fn position(&self, s: u32) -> [f64; 3] {
+        match self.mesh.source_to_welded().get(s as usize) {
+            Some(&w) if (w as usize) < self.mesh.n_vertices() => self.mesh.position(w),
+            _ => self.raw.positions[s as usize],
+        }
+    }
+
     /// Unit normal per source vertex (index = source vertex; unreferenced
     /// vertices get a normal too), see the module documentation.
     fn normals(&self) -> Vec<[f64; 3]> {

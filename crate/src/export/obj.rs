@@ -44,7 +44,7 @@ pub fn write_obj(input: &ExportInput, options: &ExportOptions) -> String {
         if *slot != 0 {
             next += 1;
             *slot = next;
-            let p = raw.positions[s];
+            let p = input.position(s as u32);
             let _ = writeln!(out, "v {} {} {}", p[0], p[1], p[2]);
         }
     }
