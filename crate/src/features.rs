@@ -209,7 +209,7 @@ pub struct Refined {
     pub original_face: Vec<u32>,
     /// Refined vertex → input vertex (`NONE` for inserted midpoints).
     pub original_vertex: Vec<u32>,
-    /// Edges split (one new vertex each).
+    /// Vertices inserted (edge midpoints and face centroids).
     pub splits: usize,
 }
 
@@ -282,43 +282,92 @@ pub fn split_doubly_constrained(mesh: &TriMesh, features: &FeatureSet) -> Option
                 }
             }
         }
-        let refined = TriMesh::from_welded_arrays(positions, triangles)
-            .expect("splitting edges at their midpoints keeps the mesh valid");
-        let mut feats = FeatureSet::none(&refined);
-        let old = |v: u32| refined.welded_to_source()[v as usize];
-        for e in 0..refined.n_edges() as u32 {
-            let [a, b] = refined.edge_vertices(e).map(old);
-            // Features are never split: a feature edge joins two old vertices.
-            if (a as usize) < m.n_vertices() && (b as usize) < m.n_vertices() {
-                if let Some(old) = m.outgoing(a).find(|&h| m.head(h) == b) {
-                    if f.contains(m.edge(old)) {
-                        feats.set(&refined, e, true);
-                    }
+        let inserted = split.iter().filter(|&&x| x).count();
+        current = Some(rebuild(m, f, current.as_ref(), positions, triangles, parent_face, inserted));
+    }
+    current.map(own_source)
+}
+
+/// Splits every face around each vertex of `vertices` at its centroid
+/// (1 → 3), on top of the refinement `current` of `mesh` (if any): the
+/// inserted interior vertices can carry curvature a lone vertex cannot
+/// (a cone of index 4 has angle 0). Features are kept.
+pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, vertices: &[u32]) -> Refined {
+    let (m, f) = match &current {
+        Some(r) => (&r.mesh, &r.features),
+        None => (mesh, features),
+    };
+    let mut marked = vec![false; m.n_faces()];
+    for &v in vertices {
+        for h in m.outgoing(v) {
+            if let Some(face) = m.face(h) {
+                marked[face as usize] = true;
+            }
+        }
+    }
+    let face_origin = |face: u32| current.as_ref().map_or(face, |r| r.original_face[face as usize]);
+    let mut positions = m.positions().to_vec();
+    let mut triangles = Vec::with_capacity(m.n_faces() + 2 * vertices.len() * 8);
+    let mut parent_face = Vec::with_capacity(triangles.capacity());
+    let mut inserted = 0;
+    for face in 0..m.n_faces() as u32 {
+        let [a, b, c] = m.faces()[face as usize];
+        if marked[face as usize] {
+            let p = [a, b, c].map(|v| m.position(v));
+            let x = positions.len() as u32;
+            positions.push([0, 1, 2].map(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0));
+            triangles.extend([[a, b, x], [b, c, x], [c, a, x]]);
+            parent_face.extend([face_origin(face); 3]);
+            inserted += 1;
+        } else {
+            triangles.push([a, b, c]);
+            parent_face.push(face_origin(face));
+        }
+    }
+    own_source(rebuild(m, f, current.as_ref(), positions, triangles, parent_face, inserted))
+}
+
+/// The refined mesh from new arrays over `m` (whose vertices keep their
+/// indices; new ones follow), with `m`'s features carried over (feature
+/// edges are never split) and the maps to the input composed with `current`.
+fn rebuild(
+    m: &TriMesh,
+    f: &FeatureSet,
+    current: Option<&Refined>,
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    original_face: Vec<u32>,
+    inserted: usize,
+) -> Refined {
+    let refined = TriMesh::from_welded_arrays(positions, triangles).expect("inserting vertices inside faces or edges keeps the mesh valid");
+    let mut features = FeatureSet::none(&refined);
+    let old = |v: u32| refined.welded_to_source()[v as usize];
+    for e in 0..refined.n_edges() as u32 {
+        let [a, b] = refined.edge_vertices(e).map(old);
+        if (a as usize) < m.n_vertices() && (b as usize) < m.n_vertices() {
+            if let Some(h) = m.outgoing(a).find(|&h| m.head(h) == b) {
+                if f.contains(m.edge(h)) {
+                    features.set(&refined, e, true);
                 }
             }
         }
-        let splits = current.as_ref().map_or(0, |r| r.splits) + split.iter().filter(|&&x| x).count();
-        let original_vertex = refined
-            .welded_to_source()
-            .iter()
-            .map(|&src| {
-                if (src as usize) >= m.n_vertices() {
-                    NONE
-                } else {
-                    current.as_ref().map_or(src, |r| r.original_vertex[src as usize])
-                }
-            })
-            .collect();
-        current = Some(Refined { mesh: refined, features: feats, splits, original_face: parent_face, original_vertex });
     }
-    // Rebuild once from the final arrays so the mesh is its own source
-    // (`source_to_welded` is the identity; edge ids are unchanged).
-    current.map(|r| {
-        let mesh = TriMesh::from_welded_arrays(r.mesh.positions().to_vec(), r.mesh.faces().to_vec())
-            .expect("rebuilding a valid mesh from its own arrays");
-        debug_assert!((0..mesh.n_edges() as u32).all(|e| mesh.edge_vertices(e) == r.mesh.edge_vertices(e)));
-        Refined { mesh, ..r }
-    })
+    let splits = current.map_or(0, |r| r.splits) + inserted;
+    let original_vertex = refined
+        .welded_to_source()
+        .iter()
+        .map(|&src| if (src as usize) >= m.n_vertices() { NONE } else { current.map_or(src, |r| r.original_vertex[src as usize]) })
+        .collect();
+    Refined { mesh: refined, features, splits, original_face, original_vertex }
+}
+
+/// Rebuilds a refinement from its own arrays so the mesh is its own source
+/// (`source_to_welded` is the identity; edge ids are unchanged).
+fn own_source(r: Refined) -> Refined {
+    let mesh = TriMesh::from_welded_arrays(r.mesh.positions().to_vec(), r.mesh.faces().to_vec())
+        .expect("rebuilding a valid mesh from its own arrays");
+    debug_assert!((0..mesh.n_edges() as u32).all(|e| mesh.edge_vertices(e) == r.mesh.edge_vertices(e)));
+    Refined { mesh, ..r }
 }
 
 /// Finds mesh vertices by position with a uniform hash grid.

@@ -1,10 +1,11 @@
 //! The whole method in one call: refine doubly constrained triangles, place
-//! cones (sections 4-5), then compute the seamless aligned parametrization
-//! (Appendix B). The CLI and the wasm API call this.
+//! cones (sections 4-5) — refining around any vertex that would need a cone
+//! of angle 0 and placing them again —, then compute the seamless aligned
+//! parametrization (Appendix B). The CLI and the wasm API call this.
 
 use crate::clock::Stopwatch;
 use crate::cones::{self, ConeError, ConeOptions, ConePlacement};
-use crate::features::{split_doubly_constrained, FeatureSet};
+use crate::features::{split_around, split_doubly_constrained, FeatureSet, Refined};
 use crate::mesh::TriMesh;
 use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrization};
 use std::borrow::Cow;
@@ -112,14 +113,46 @@ pub fn solve<'a>(
     progress: &mut dyn FnMut(SolveProgress),
 ) -> Result<Solution<'a>, SolveError> {
     let mut clock = Stopwatch::start();
-    let (mesh, features, splits, original_face, original_vertex) = match split_doubly_constrained(mesh, features) {
-        Some(r) => (Cow::Owned(r.mesh), Cow::Owned(r.features), r.splits, Some(r.original_face), Some(r.original_vertex)),
+    let mut refined = split_doubly_constrained(mesh, features);
+    let mut refine_seconds = clock.lap();
+    let mut attempt = 0;
+    let placement = loop {
+        let (m, f) = refined.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
+        let placement = cones::place_cones(m, f, &options.cones, &mut |p| progress(SolveProgress::Cones(p)))
+            .map_err(SolveError::Cones)?;
+        let degenerate = zero_angle_cones(&placement);
+        if degenerate.is_empty() || attempt == MAX_CONE_REFINEMENTS {
+            break placement;
+        }
+        // Only vertices of `m` are named; lift the refinement one level.
+        clock.lap();
+        refined = Some(split_around(mesh, features, refined.take(), &degenerate));
+        refine_seconds += clock.lap();
+        attempt += 1;
+    };
+    let (mesh, features, splits, original_face, original_vertex) = match refined {
+        Some(Refined { mesh: m, features: f, splits, original_face, original_vertex }) => {
+            (Cow::Owned(m), Cow::Owned(f), splits, Some(original_face), Some(original_vertex))
+        }
         None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None),
     };
-    let refine_seconds = clock.lap();
-    let placement = cones::place_cones(&mesh, &features, &options.cones, &mut |p| progress(SolveProgress::Cones(p)))
-        .map_err(SolveError::Cones)?;
     let param = param::parametrize(&mesh, &placement, &options.param, &mut |p| progress(SolveProgress::Param(p)))
         .map_err(SolveError::Param)?;
     Ok(Solution { mesh, features, splits, original_face, original_vertex, placement, param, refine_seconds })
+}
+
+/// Rounds of local refinement tried when cones of angle 0 appear.
+const MAX_CONE_REFINEMENTS: usize = 2;
+
+/// Vertices (of the mesh the placement was computed on) that carry an
+/// interior cone of index `k >= 4`, i.e. a cone angle `<= 0`.
+fn zero_angle_cones(placement: &ConePlacement) -> Vec<u32> {
+    let cm = &placement.cut.mesh;
+    let mut out: Vec<u32> = (0..cm.n_vertices() as u32)
+        .filter(|&v| placement.k[v as usize] >= 4 && !cm.is_boundary_vertex(v))
+        .map(|v| placement.cut.original_vertex[v as usize])
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
 }

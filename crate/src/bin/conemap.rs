@@ -445,7 +445,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
         result.seam_edges.len()
     );
     if solution.splits > 0 {
-        println!("  note: split {} edges so no triangle has two constrained edges", solution.splits);
+        println!("  note: inserted {} vertices (midpoints of triangles with two constrained edges, centroids around cones of angle 0); the output is the refined mesh", solution.splits);
     }
     for note in input.notes() {
         println!("  note: {note}");
