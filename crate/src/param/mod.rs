@@ -50,7 +50,7 @@ pub struct ParamOptions {
 
 impl Default for ParamOptions {
     fn default() -> Self {
-        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 12, refine: injective::RefineOptions::default() }
+        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 60, refine: injective::RefineOptions::default() }
     }
 }
 

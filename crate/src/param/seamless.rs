@@ -17,6 +17,9 @@ use crate::cones::ConePlacement;
 use crate::linalg::{Kkt, LdltSolver, SolverOptions, Triplet};
 use crate::mesh::TriMesh;
 
+/// Repair rounds tried without lowering the number of folds before giving up.
+const REPAIR_PATIENCE: usize = 16;
+
 /// Result of [`solve`]: UV per wedge.
 #[derive(Clone, Debug)]
 pub struct SeamlessResult {
@@ -291,7 +294,10 @@ pub fn solve(
     let mut round = 0;
     let mut pinned = fixed.clone();
     let relax = options.refine.max_iterations == 0;
-    while !flips.is_empty() && round < options.repair_rounds {
+    // Rounds go on while they make progress: finer meshes need more of them
+    // (the 52 k-face fandisk needed 13-24).
+    let mut stalled = 0;
+    while !flips.is_empty() && round < options.repair_rounds && stalled < REPAIR_PATIENCE {
         round += 1;
         progress(ParamProgress::Repair { round, flips: flips.len() });
         for &f in &flips {
@@ -315,6 +321,9 @@ pub fn solve(
         if flips.len() < best_flips {
             best_flips = flips.len();
             best_uv = uv.clone();
+            stalled = 0;
+        } else {
+            stalled += 1;
         }
     }
     // Relaxation (only without the injective refinement): once fold-free,
