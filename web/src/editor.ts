@@ -3,7 +3,8 @@
 import * as THREE from 'three';
 import { FeatureSet } from './features';
 import { definitionList } from './panels';
-import type { ImportResult, SolveResult } from './protocol';
+import type { ImportResult, SolveResult, SolveView } from './protocol';
+import { buildSolveView } from './solve-view';
 import { type Adjacency, shortestPath } from './topology';
 import { UvView } from './uvview';
 import { COLORS, type SurfaceMode, type Viewer, heat } from './viewer';
@@ -57,6 +58,20 @@ const fmt = (x: number, digits = 3): string =>
 const fmtInt = (n: number): string => n.toLocaleString('en-US');
 const alphaOf = (slider: number): number => 10 ** slider;
 
+/** Longest wait for an animation frame while building the view (hidden pages get none). */
+const FRAME_WAIT_MS = 1000;
+
+/** Resolves in a task after the next animation frame (so after that frame was drawn), or after FRAME_WAIT_MS without one. */
+function afterNextFrame(): Promise<void> {
+  return new Promise((resolve) => {
+    const timer = setTimeout(resolve, FRAME_WAIT_MS);
+    requestAnimationFrame(() => {
+      clearTimeout(timer);
+      setTimeout(resolve, 0);
+    });
+  });
+}
+
 interface MeshState {
   label: string;
   data: ImportResult;
@@ -69,6 +84,12 @@ export class Editor {
   private mesh: MeshState | null = null;
   private anchor: number | null = null;
   private solving = false;
+  /** The solver has answered and its result is being put on screen (over a few frames). */
+  private building = false;
+  /** Ends the wait for the view being built at once (set while `building`). */
+  private abortBuild: (() => void) | null = null;
+  /** Bumped whenever the shown result is cleared: a view build that sees it change stops. */
+  private viewEpoch = 0;
   private result: SolveResult | null = null;
   private resultSettings: Record<string, unknown> | null = null;
   private uvView: UvView;
@@ -142,6 +163,7 @@ export class Editor {
   }
 
   private clearResult(): void {
+    this.viewEpoch++;
     this.result = null;
     this.resultSettings = null;
     this.hooks.result = null;
@@ -150,7 +172,7 @@ export class Editor {
     this.uvView.clear();
     this.viewer.setCones([], []);
     this.viewer.setLines('seams', this.mesh?.edges ?? new Uint32Array(0), [], COLORS.seam);
-    this.viewer.setUvSurface(null, null);
+    this.viewer.setUvSurface(null);
     this.viewer.setHoverFace(null);
   }
 
@@ -182,7 +204,7 @@ export class Editor {
     this.el.clear.disabled = !f || n === 0;
     this.el.sharpToggle.disabled = !f;
     this.el.run.disabled = !this.mesh || this.solving;
-    this.el.cancel.disabled = !this.solving;
+    this.el.cancel.disabled = !this.solving || this.building;
   }
 
   private changed(did: boolean): void {
@@ -323,7 +345,7 @@ export class Editor {
     });
     el.obj.addEventListener('click', () => {
       const obj = this.result?.obj;
-      if (obj) download(new Blob([obj], { type: 'text/plain' }), `${this.baseName()}-uv.obj`);
+      if (obj) download(new Blob([obj as Uint8Array<ArrayBuffer>], { type: 'text/plain' }), `${this.baseName()}-uv.obj`);
     });
   }
 
@@ -362,6 +384,8 @@ export class Editor {
         return [`Injective refinement: iteration ${step} of at most ${fmtInt(remaining)}`, remaining ? step / remaining : undefined];
       case 'pair cancellation':
         return [`Cancelling cone pairs (${fmtInt(step)} removed)`, undefined];
+      case 'building view':
+        return ['Building the view…', undefined];
       default: {
         const label = stage.charAt(0).toUpperCase() + stage.slice(1);
         const of = remaining ? ` (${fmtInt(remaining)} remaining)` : '';
@@ -407,7 +431,10 @@ export class Editor {
       this.clearResult();
       this.result = result;
       this.resultSettings = { ...settings, wall_ms: performance.now() - t0 };
-      this.showResult(m, result);
+      this.building = true;
+      this.updateFeatureUi();
+      const aborted = new Promise<boolean>((resolve) => (this.abortBuild = () => resolve(false)));
+      if (!(await Promise.race([this.showResult(m, result), aborted]))) throw new Cancelled('cancelled while building the view');
       this.hooks.solveError = null;
       this.setState('solved');
     } catch (e) {
@@ -421,6 +448,8 @@ export class Editor {
         this.setState(this.result ? 'solved' : 'ready');
       }
     } finally {
+      this.building = false;
+      this.abortBuild = null;
       if (this.mesh === m) {
         this.solving = false;
         delete document.body.dataset['solving'];
@@ -431,24 +460,40 @@ export class Editor {
     }
   }
 
-  /** Stops a running solve: the worker is terminated and replaced at once (the mesh is re-opened in the new one). */
+  /**
+   * Stops a running solve: the worker is terminated and replaced at once (the
+   * mesh is re-opened in the new one); once the solver has answered, the view
+   * being built is dropped instead.
+   */
   cancelSolve(): void {
     if (!this.solving) return;
-    this.worker.cancel();
-    this.el.status.textContent = 'Cancelled; the solver was stopped.';
-    this.el.status.hidden = false;
+    if (this.building) {
+      this.clearResult();
+      this.abortBuild?.();
+    } else {
+      this.worker.cancel();
+      this.el.status.textContent = 'Cancelled; the solver was stopped.';
+      this.el.status.hidden = false;
+    }
     this.solving = false;
     delete document.body.dataset['solving'];
     this.el.progress.hidden = true;
     this.updateFeatureUi();
   }
 
-  private showResult(m: MeshState, r: SolveResult): void {
+  /**
+   * Shows a finished solve: the figures at once; with UVs, then the 3D surface
+   * with seams and cones in one frame and the UV layout in the next (their
+   * shaders compiled first), the stage line saying so meanwhile. Resolves true
+   * once all is shown, false when the result was cleared on the way.
+   */
+  private async showResult(m: MeshState, r: SolveResult): Promise<boolean> {
+    const epoch = this.viewEpoch;
+    const live = (): boolean => this.viewEpoch === epoch;
     const plus = r.cones.filter((c) => c.k > 0).length;
     const minus = r.cones.filter((c) => c.k < 0).length;
     const sumConeK = r.cones.reduce((s, c) => s + c.k, 0);
     const sumCornerK = r.boundary_corners.reduce((s, c) => s + c.k, 0);
-    this.viewer.setCones(r.cones, r.boundary_corners);
     const report = m.data.report;
     const genus = report?.genus?.length ? report.genus.join(', ') : '—';
     const coneText = `${fmtInt(r.cones.length)} (+${plus} / −${minus})`;
@@ -487,7 +532,7 @@ export class Editor {
       }
     }
     const splits = (r as { split_edges?: number }).split_edges;
-    if (typeof splits === 'number' && splits > 0) rows.push(['Split edges', fmtInt(splits)]);
+    if (typeof splits === 'number' && splits > 0) rows.push(['Inserted vertices (refinement)', fmtInt(splits)]);
     rows.push(['Time in worker', `${r.elapsed.toFixed(0)} ms`]);
     const list = definitionList(rows);
     const coneDd = list.querySelector<HTMLElement>('dd[data-stat=cones]');
@@ -507,21 +552,33 @@ export class Editor {
     this.el.json.disabled = false;
     this.el.distortionLegend.hidden = true;
     if (hasUv && r.uv) {
-      const perFace = metrics?.per_face_distortion;
-      const colors = perFace ? this.distortionColors(perFace) : null;
-      this.viewer.setUvSurface(r.uv, colors);
-      if (r.seam_edges) this.viewer.setLines('seams', m.edges, r.seam_edges, COLORS.seam, 2.5, 2);
-      this.el.uv.hidden = false;
-      // Chart outlines in the UV view: face sides on a seam or on the boundary.
-      const cut = new Uint8Array(m.edges.length / 2);
-      for (const e of r.seam_edges ?? []) cut[e] = 1;
-      for (const e of m.data.boundary) cut[e] = 1;
-      const sides: number[] = [];
-      const fe = m.data.faceEdges;
-      for (let i = 0; i < fe.length; i++) if (fe[i]! < cut.length && cut[fe[i]!]) sides.push(i);
-      this.uvView.show(r.uv, colors, Uint32Array.from(sides));
+      this.setProgress('building view');
+      const view = r.view ?? this.buildView(m, r.uv, r);
+      const distortion = view.distortion;
+      if (distortion) this.drawDistortionScale(distortion.max, distortion.histogram);
+      const colors = distortion?.colors ?? null;
+      // The 3D view: everything at once, so that it renders once (a full frame of a big mesh is costly).
+      this.viewer.setCones(r.cones, r.boundary_corners);
+      this.viewer.setUvSurface({ positions: view.cornerPositions, uv: view.checkerUv, colors });
+      this.viewer.setSegments('seams', view.seamSegments, COLORS.seam, 2.5, 2);
       this.setSurface('checker');
+      await this.viewer.prepare();
+      if (!live()) return false;
+      await afterNextFrame();
+      if (!live()) return false;
+      // The UV layout, in the next frame.
+      this.el.uv.hidden = false;
+      this.uvView.show({
+        uv: r.uv, positions: view.layoutPositions, checkerUv: view.checkerUv, colors,
+        outline: view.cutSegments, bounds: view.layoutBounds, sphere: view.layoutSphere,
+      });
+      this.uvView.setColored(this.surfaceMode() === 'distortion');
+      await this.uvView.prepare();
+      if (!live()) return false;
+      await afterNextFrame();
+      if (!live()) return false;
     } else {
+      this.viewer.setCones(r.cones, r.boundary_corners);
       this.viewer.setSurfaceMode('shaded');
     }
     this.hooks.result = {
@@ -538,31 +595,24 @@ export class Editor {
       uv: hasUv,
       seams: r.seam_edges?.length ?? 0,
     };
+    return true;
   }
 
+  /** The display arrays of a solve built on this thread (when the worker sent none); `uv` is `r.uv`. */
+  private buildView(m: MeshState, uv: Float32Array, r: SolveResult): SolveView {
+    return buildSolveView({
+      positions: m.data.positions, indices: m.data.indices, edges: m.edges, boundary: m.data.boundary,
+      faceEdges: m.data.faceEdges, uv, seamEdges: r.seam_edges ?? null,
+      perFaceDistortion: r.metrics?.per_face_distortion ?? null,
+    });
+  }
 
-  /** Per-corner colours from per-face distortion; also draws the histogram. */
-  private distortionColors(perFace: Float32Array): Float32Array {
-    const sorted = Float32Array.from(perFace).sort();
-    const p99 = sorted[Math.min(sorted.length - 1, Math.floor(sorted.length * 0.99))] ?? 1;
-    const max = Math.max(p99, 1e-6);
-    const colors = new Float32Array(perFace.length * 9);
-    const c = new THREE.Color();
-    for (let f = 0; f < perFace.length; f++) {
-      heat(perFace[f]! / max, c);
-      for (let k = 0; k < 3; k++) colors.set([c.r, c.g, c.b], 9 * f + 3 * k);
-    }
+  /** The distortion legend: its scale `max` and the histogram of `counts` (equal bins of value / max over 0..1). */
+  private drawDistortionScale(max: number, counts: Uint32Array): void {
     this.el.distortionMax.textContent = fmt(max);
-    this.drawHistogram(perFace, max);
-    return colors;
-  }
-
-  private drawHistogram(values: Float32Array, max: number): void {
     const canvas = this.el.histogram;
     const g = canvas.getContext('2d')!;
-    const bins = 40;
-    const counts = new Uint32Array(bins);
-    for (const v of values) counts[Math.min(bins - 1, Math.max(0, Math.floor((v / max) * bins)))]!++;
+    const bins = counts.length;
     const top = Math.max(...counts, 1);
     g.clearRect(0, 0, canvas.width, canvas.height);
     const w = canvas.width / bins;
@@ -573,6 +623,11 @@ export class Editor {
       g.fillStyle = `#${col.getHexString()}`;
       g.fillRect(i * w + 0.5, canvas.height - h, w - 1, h);
     }
+  }
+
+  /** The surface mode of the checked radio button ('shaded' when none is). */
+  private surfaceMode(): SurfaceMode {
+    return (document.querySelector<HTMLInputElement>('input[name=surface]:checked')?.value as SurfaceMode | undefined) ?? 'shaded';
   }
 
   private setSurface(mode: SurfaceMode): void {
@@ -591,7 +646,7 @@ export class Editor {
     const m = this.mesh;
     const r = this.result;
     if (!m || !r) return null;
-    const { uv: _uv, glb: _glb, obj: _obj, seam_edges: seams, metrics, ...rest } = r;
+    const { uv: _uv, glb: _glb, obj: _obj, view: _view, seam_edges: seams, metrics, ...rest } = r;
     const metricsOut = metrics ? { ...metrics, per_face_distortion: undefined } : undefined;
     return {
       tool: 'conemap',

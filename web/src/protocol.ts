@@ -120,7 +120,33 @@ export interface SolveResult {
   metrics?: SolveMetrics;
   /** Exports, produced in the worker right after the solve. */
   glb?: Uint8Array;
-  obj?: string;
+  /** The OBJ export as UTF-8 bytes (encoded in the worker, so that it is transferred rather than copied). */
+  obj?: Uint8Array;
+  /** Display arrays built in the worker from `uv` (present with `uv`; see solve-view.ts). */
+  view?: SolveView;
+}
+
+/**
+ * What the page shows of a solve with UVs, ready to upload (typed arrays,
+ * transferred from the worker). Corners are 3f+k (face f, corner k).
+ */
+export interface SolveView {
+  /** xyz per corner: the mesh positions unwelded (the UV-textured surface). */
+  cornerPositions: Float32Array;
+  /** The UVs scaled for the checker texture, 2 per corner (shared by the 3D and the 2D view). */
+  checkerUv: Float32Array;
+  /** The UV layout as xyz per corner (z = 0), for the 2D view. */
+  layoutPositions: Float32Array;
+  /** [min u, min v, max u, max v] of the layout. */
+  layoutBounds: [number, number, number, number];
+  /** Bounding sphere of `layoutPositions`: [centre u, centre v, radius]. */
+  layoutSphere: [number, number, number];
+  /** Chart outlines (seam and boundary sides) in the layout: 2 xyz points per segment, raw UVs, z = 0.005. */
+  cutSegments: Float32Array;
+  /** Seam edges in 3D: 2 xyz points per segment, in `seam_edges` order. */
+  seamSegments: Float32Array;
+  /** Per-face distortion shown as colours: scale (99th percentile), rgb per corner, 40-bin histogram of value / max. */
+  distortion: { max: number; colors: Float32Array; histogram: Uint32Array } | null;
 }
 
 export interface SharpResult {

@@ -3,7 +3,25 @@
 // known, with the hovered face highlighted in sync with the 3D view.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { checkerTexture, checkerUv, createRenderer, frameScheduler } from './viewer';
+import { RenderScheduler, checkerTexture, createRenderer, precompile } from './viewer';
+
+/** A UV layout to show (see `SolveView` in protocol.ts); the arrays are used as they are (not copied). */
+export interface UvLayout {
+  /** The raw UVs, 2 per face corner 3f+k (for the hover highlight). */
+  uv: Float32Array;
+  /** xyz per corner (z = 0). */
+  positions: Float32Array;
+  /** UVs scaled for the checker texture, 2 per corner. */
+  checkerUv: Float32Array;
+  /** rgb per corner (distortion), or null. */
+  colors: Float32Array | null;
+  /** Chart outlines: 2 xyz points per segment. */
+  outline: Float32Array;
+  /** [min u, min v, max u, max v]. */
+  bounds: [number, number, number, number];
+  /** Bounding sphere of `positions`: [centre u, centre v, radius]. */
+  sphere: [number, number, number];
+}
 
 export class UvView {
   private readonly renderer: THREE.WebGLRenderer;
@@ -49,7 +67,7 @@ export class UvView {
       pending = e;
     });
     this.renderer.domElement.addEventListener('pointerleave', () => this.onHover?.(null));
-    new ResizeObserver(() => this.resize()).observe(container);
+    new ResizeObserver(() => this.resized()).observe(container);
   }
 
   /** Colours the layout by distortion (when given to `show`) or plainly. */
@@ -64,42 +82,26 @@ export class UvView {
     this.requestRender();
   }
 
-  /**
-   * Shows a layout: `uv` has 2 floats per face corner; `colors` (rgb per corner)
-   * optional; `cutSides` lists face sides (3f+k, corner k → k+1) drawn as chart
-   * outlines (seams and boundary).
-   */
-  show(uv: Float32Array, colors: Float32Array | null, cutSides: Uint32Array | null = null): void {
+  /** Shows a layout (its triangles, the chart outlines, and triangle outlines when small) and frames it. */
+  show(layout: UvLayout): void {
     this.clear();
+    const { uv, positions: pos } = layout;
     this.uv = uv;
     const corners = uv.length / 2;
-    const pos = new Float32Array(corners * 3);
-    this.bounds.makeEmpty();
-    const p = new THREE.Vector2();
-    for (let c = 0; c < corners; c++) {
-      pos[3 * c] = uv[2 * c]!;
-      pos[3 * c + 1] = uv[2 * c + 1]!;
-      this.bounds.expandByPoint(p.set(uv[2 * c]!, uv[2 * c + 1]!));
-    }
+    const [minU, minV, maxU, maxV] = layout.bounds;
+    if (corners > 0) this.bounds.set(new THREE.Vector2(minU, minV), new THREE.Vector2(maxU, maxV));
+    else this.bounds.makeEmpty();
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    g.setAttribute('uv', new THREE.BufferAttribute(checkerUv(uv), 2));
-    if (colors) g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
-    g.computeBoundingSphere();
+    g.setAttribute('uv', new THREE.BufferAttribute(layout.checkerUv, 2));
+    if (layout.colors) g.setAttribute('color', new THREE.BufferAttribute(layout.colors, 3));
+    g.boundingSphere = new THREE.Sphere(new THREE.Vector3(layout.sphere[0], layout.sphere[1], 0), layout.sphere[2]);
     this.mesh = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ side: THREE.DoubleSide }));
     this.scene.add(this.mesh);
     this.setColored(false);
-    if (cutSides && cutSides.length) {
-      const seg = new Float32Array(cutSides.length * 6);
-      for (let i = 0; i < cutSides.length; i++) {
-        const s = cutSides[i]!;
-        const f = Math.floor(s / 3);
-        const a = 3 * f + (s % 3);
-        const b = 3 * f + ((s % 3) + 1) % 3;
-        seg.set([uv[2 * a]!, uv[2 * a + 1]!, 0.005, uv[2 * b]!, uv[2 * b + 1]!, 0.005], 6 * i);
-      }
+    if (layout.outline.length) {
       const sg = new THREE.BufferGeometry();
-      sg.setAttribute('position', new THREE.BufferAttribute(seg, 3));
+      sg.setAttribute('position', new THREE.BufferAttribute(layout.outline, 3));
       this.seams = new THREE.LineSegments(sg, new THREE.LineBasicMaterial({ color: 0xff4fa3 }));
       this.seams.renderOrder = 2;
       this.scene.add(this.seams);
@@ -173,10 +175,28 @@ export class UvView {
     return hit?.faceIndex ?? null;
   }
 
+  /** Drawing-buffer size last set, and whether a resize found the container hidden since. */
+  private size = { w: 0, h: 0 };
+  private stale = true;
+
+  /** Applies a container size change (ResizeObserver): nothing when the size is the one applied and no resize was skipped. */
+  private resized(): void {
+    const { clientWidth: w, clientHeight: h } = this.container;
+    if (this.stale || w !== this.size.w || h !== this.size.h) this.resize();
+  }
+
   private resize(): void {
     const { clientWidth: w, clientHeight: h } = this.container;
-    if (w === 0 || h === 0) return;
-    this.renderer.setSize(w, h, false);
+    if (w === 0 || h === 0) {
+      this.stale = true;
+      return;
+    }
+    this.stale = false;
+    // Setting the canvas size clears it: only when it changes.
+    if (w !== this.size.w || h !== this.size.h) {
+      this.size = { w, h };
+      this.renderer.setSize(w, h, false);
+    }
     const aspect = w / h;
     const c = this.controls.target;
     this.camera.left = -this.span * aspect;
@@ -189,8 +209,15 @@ export class UvView {
     this.requestRender();
   }
 
+  private readonly scheduler = new RenderScheduler(() => this.renderNow());
+
   /** Renders at the next animation frame (once, however often it is called before then). */
-  readonly requestRender = frameScheduler(() => this.renderNow());
+  readonly requestRender = (): void => this.scheduler.request();
+
+  /** Compiles the shaders of the layout as it is now, holding renders until they are ready (see `precompile`). */
+  prepare(): Promise<void> {
+    return precompile(this.renderer, this.scene, this.camera, this.scheduler);
+  }
 
   renderNow(): void {
     this.renderer.render(this.scene, this.camera);

@@ -8,6 +8,7 @@ import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
 import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
 import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
 import type { Cone } from './protocol';
+import { edgeSegments, heatRgb } from './solve-view';
 
 export interface MeshData {
   positions: Float32Array;
@@ -33,15 +34,12 @@ export function coneColor(k: number): number {
   return k === 1 ? COLORS.conePlus : k === -1 ? COLORS.coneMinus : COLORS.coneOther;
 }
 
-/** Distortion colour ramp (0 = none … 1 = strong): blue → white → red. */
+const heatScratch = [0, 0, 0];
+
+/** Distortion colour ramp (0 = none … 1 = strong): blue → white → red (see `heatRgb`). */
 export function heat(t: number, out: THREE.Color = new THREE.Color()): THREE.Color {
-  const x = Math.max(0, Math.min(1, t));
-  if (x < 0.5) {
-    const y = x * 2;
-    return out.setRGB(0.23 + 0.72 * y, 0.45 + 0.5 * y, 0.95);
-  }
-  const y = (x - 0.5) * 2;
-  return out.setRGB(0.95 - 0.05 * y, 0.95 - 0.75 * y, 0.95 - 0.75 * y);
+  heatRgb(t, heatScratch, 0);
+  return out.setRGB(heatScratch[0]!, heatScratch[1]!, heatScratch[2]!);
 }
 
 /** An 8 × 8 checkerboard, repeating. */
@@ -65,20 +63,6 @@ export function checkerTexture(): THREE.Texture {
   return t;
 }
 
-/** UVs scaled for the checker texture: 20 squares across the layout's larger side. */
-export function checkerUv(uv: Float32Array): Float32Array {
-  const scaled = new Float32Array(uv.length);
-  let lo = Infinity;
-  let hi = -Infinity;
-  for (const x of uv) {
-    if (x < lo) lo = x;
-    if (x > hi) hi = x;
-  }
-  const scale = hi > lo ? 2.5 / (hi - lo) : 1;
-  for (let i = 0; i < uv.length; i++) scaled[i] = uv[i]! * scale;
-  return scaled;
-}
-
 /** A WebGL renderer (antialiased, drawing buffer kept for screenshots, pixel ratio ≤ 2) whose canvas, with `data-testid` = `testid`, is appended to `container`. */
 export function createRenderer(container: HTMLElement, testid: string): THREE.WebGLRenderer {
   const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -88,17 +72,72 @@ export function createRenderer(container: HTMLElement, testid: string): THREE.We
   return renderer;
 }
 
-/** Wraps `draw` so that any number of calls within one frame run it once, at the next animation frame. */
-export function frameScheduler(draw: () => void): () => void {
-  let requested = false;
-  return () => {
-    if (requested) return;
-    requested = true;
+/** Longest wait for shaders to compile before rendering anyway (a lost context never reports them ready). */
+const COMPILE_WAIT_MS = 3000;
+
+/**
+ * Runs `draw` at the next animation frame on request, once however often it is
+ * requested before then; while held, requests wait and draw once on release.
+ */
+export class RenderScheduler {
+  private requested = false;
+  private holds = 0;
+  private waiting = false;
+
+  constructor(private readonly draw: () => void) {}
+
+  /** Draws at the next animation frame (or, while held, after the release). */
+  request(): void {
+    if (this.holds > 0) {
+      this.waiting = true;
+      return;
+    }
+    if (this.requested) return;
+    this.requested = true;
     requestAnimationFrame(() => {
-      requested = false;
-      draw();
+      this.requested = false;
+      if (this.holds > 0) this.waiting = true;
+      else this.draw();
     });
-  };
+  }
+
+  /** Holds drawing until `work` settles (at most COMPILE_WAIT_MS), then requests a draw if one waited. */
+  async holdWhile(work: Promise<unknown>): Promise<void> {
+    this.holds++;
+    let timer = 0;
+    try {
+      await Promise.race([work.catch(() => undefined), new Promise((r) => (timer = window.setTimeout(r, COMPILE_WAIT_MS)))]);
+    } finally {
+      clearTimeout(timer);
+      this.holds--;
+      if (this.holds === 0 && this.waiting) {
+        this.waiting = false;
+        this.request();
+      }
+    }
+  }
+}
+
+/** Head start given to shader compilation where its end cannot be observed without blocking. */
+const COMPILE_HEAD_START_MS = 10;
+
+/**
+ * Compiles the shaders `scene` needs through `renderer` while `scheduler` holds
+ * drawing, so that the next frame does not stall on them; resolves when they are
+ * ready (with KHR_parallel_shader_compile) or after a short head start (without
+ * it, e.g. SwiftShader or Firefox, where `compileAsync` would also warn).
+ */
+export function precompile(renderer: THREE.WebGLRenderer, scene: THREE.Scene, camera: THREE.Camera, scheduler: RenderScheduler): Promise<void> {
+  if (renderer.extensions.has('KHR_parallel_shader_compile')) return scheduler.holdWhile(renderer.compileAsync(scene, camera));
+  renderer.compile(scene, camera);
+  return scheduler.holdWhile(new Promise((resolve) => setTimeout(resolve, COMPILE_HEAD_START_MS)));
+}
+
+/** A solve's surface for the 3D view: positions and checker-scaled UVs per face corner, optional rgb per corner. */
+export interface UvSurface {
+  positions: Float32Array;
+  uv: Float32Array;
+  colors: Float32Array | null;
 }
 
 export interface Pick {
@@ -210,11 +249,13 @@ export class Viewer {
   }
 
   /**
-   * UV results: a face-corner geometry (positions per corner) carrying `uv` and,
-   * when given, per-face distortion colours (`colors`, rgb per corner). Null
-   * goes back to the plain mesh.
+   * UV results: a face-corner geometry (`surface.positions`, xyz per corner)
+   * carrying `surface.uv` (already scaled for the checker) and, when given,
+   * per-face distortion colours (rgb per corner); the arrays are used as they
+   * are (not copied). Null goes back to the plain mesh.
    */
-  setUvSurface(uv: Float32Array | null, colors: Float32Array | null): void {
+  setUvSurface(surface: UvSurface | null): void {
+    if (!surface && !this.uvMesh) return; // nothing shown, nothing to draw again
     if (this.uvMesh) {
       this.group.remove(this.uvMesh);
       this.uvMesh.geometry.dispose();
@@ -222,19 +263,11 @@ export class Viewer {
       this.uvMesh = null;
     }
     if (this.mesh) this.mesh.visible = true;
-    if (uv && this.data && this.mesh) {
-      const { positions, indices } = this.data;
-      const corner = new Float32Array(indices.length * 3);
-      for (let c = 0; c < indices.length; c++) {
-        const v = indices[c]!;
-        corner[3 * c] = positions[3 * v]!;
-        corner[3 * c + 1] = positions[3 * v + 1]!;
-        corner[3 * c + 2] = positions[3 * v + 2]!;
-      }
+    if (surface && this.data && this.mesh) {
       const g = new THREE.BufferGeometry();
-      g.setAttribute('position', new THREE.BufferAttribute(corner, 3));
-      g.setAttribute('uv', new THREE.BufferAttribute(checkerUv(uv), 2));
-      if (colors) g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
+      g.setAttribute('position', new THREE.BufferAttribute(surface.positions, 3));
+      g.setAttribute('uv', new THREE.BufferAttribute(surface.uv, 2));
+      if (surface.colors) g.setAttribute('color', new THREE.BufferAttribute(surface.colors, 3));
       g.boundingSphere = this.mesh.geometry.boundingSphere;
       this.uvMesh = new THREE.Mesh(g, new THREE.MeshBasicMaterial());
       this.group.add(this.uvMesh);
@@ -274,24 +307,21 @@ export class Viewer {
    * 'boundary', 'seams'); an empty list hides the layer.
    */
   setLines(name: string, edges: Uint32Array, edgeIds: ArrayLike<number>, color: number, width = 3, order = 0): void {
+    const seg = this.data && edgeIds.length ? edgeSegments(this.data.positions, edges, edgeIds) : new Float32Array(0);
+    this.setSegments(name, seg, color, width, order);
+  }
+
+  /** Like `setLines` with the segments given (2 xyz points each, mesh coordinates; used as is). */
+  setSegments(name: string, seg: Float32Array, color: number, width = 3, order = 0): void {
     const old = this.lines.get(name);
     if (old) {
       this.group.remove(old);
       old.geometry.dispose();
       this.lines.delete(name);
     }
-    if (!this.data || edgeIds.length === 0) {
-      this.requestRender();
+    if (!this.data || seg.length === 0) {
+      if (old) this.requestRender();
       return;
-    }
-    const p = this.data.positions;
-    const seg = new Float32Array(edgeIds.length * 6);
-    for (let i = 0; i < edgeIds.length; i++) {
-      const e = edgeIds[i]!;
-      const a = edges[2 * e]!;
-      const b = edges[2 * e + 1]!;
-      seg.set(p.subarray(3 * a, 3 * a + 3), 6 * i);
-      seg.set(p.subarray(3 * b, 3 * b + 3), 6 * i + 3);
     }
     const g = new LineSegmentsGeometry();
     g.setPositions(seg);
@@ -318,6 +348,7 @@ export class Viewer {
 
   /** Cones as spheres coloured by index; boundary corners as small cubes. */
   setCones(cones: Cone[], corners: Cone[]): void {
+    if (cones.length === 0 && corners.length === 0 && this.markers.children.length === 0) return;
     for (const child of [...this.markers.children]) {
       this.markers.remove(child);
       const m = child as THREE.InstancedMesh;
@@ -457,7 +488,7 @@ export class Viewer {
   }
 
   private clear(): void {
-    this.setUvSurface(null, null);
+    this.setUvSurface(null);
     for (const name of [...this.lines.keys()]) this.setLines(name, new Uint32Array(0), [], 0);
     this.setCones([], []);
     this.setAnchor(null);
@@ -474,9 +505,13 @@ export class Viewer {
     this.data = null;
   }
 
+  private size = { w: 0, h: 0 };
+
+  /** Fits the drawing buffer and camera to the container; nothing (no clear, no render) when its size is unchanged. */
   private resize(): void {
     const { clientWidth: w, clientHeight: h } = this.container;
-    if (w === 0 || h === 0) return;
+    if (w === 0 || h === 0 || (w === this.size.w && h === this.size.h)) return;
+    this.size = { w, h };
     this.renderer.setSize(w, h, false);
     this.renderer.domElement.style.width = '100%';
     this.renderer.domElement.style.height = '100%';
@@ -486,8 +521,15 @@ export class Viewer {
     this.requestRender();
   }
 
+  private readonly scheduler = new RenderScheduler(() => this.renderNow());
+
   /** Renders at the next animation frame (once, however often it is called before then). */
-  readonly requestRender = frameScheduler(() => this.renderNow());
+  readonly requestRender = (): void => this.scheduler.request();
+
+  /** Compiles the shaders of the scene as it is now, holding renders until they are ready (see `precompile`). */
+  prepare(): Promise<void> {
+    return precompile(this.renderer, this.scene, this.camera, this.scheduler);
+  }
 
   /** Renders now (used before screenshots and after loading, so "ready" means drawn). */
   renderNow(): void {

@@ -4,7 +4,8 @@
 // solves do not re-import it.
 import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { ImportResult, MeshReport, Request, Response, SolveResult } from './protocol';
+import type { ImportResult, MeshReport, Request, Response, SolveResult, SolveView } from './protocol';
+import { buildSolveView, viewBuffers } from './solve-view';
 import { buildAdjacency, faceEdges } from './topology';
 
 interface WorkerScope {
@@ -136,19 +137,44 @@ function solve(req: Extract<Request, { type: 'solve' }>): { value: unknown; tran
     if (typeof raw['free'] === 'function') (raw['free'] as () => void).call(raw);
     if (Array.isArray(out['uv'])) out['uv'] = Float32Array.from(out['uv'] as number[]);
     if (Array.isArray(out['seam_edges'])) out['seam_edges'] = Uint32Array.from(out['seam_edges'] as number[]);
+    if (typeof out['obj'] === 'string') out['obj'] = new TextEncoder().encode(out['obj']);
     const metrics = out['metrics'] as Record<string, unknown> | undefined;
     if (metrics && Array.isArray(metrics['per_face_distortion'])) {
       metrics['per_face_distortion'] = Float32Array.from(metrics['per_face_distortion'] as number[]);
     }
-    const value = { ...(out as unknown as SolveResult), elapsed: performance.now() - t0 };
-    const transfer: Transferable[] = [];
-    for (const v of [value.uv, value.seam_edges, value.glb, value.metrics?.per_face_distortion]) {
+    const solved = out as unknown as SolveResult;
+    const view = solveView(s, solved);
+    const value: SolveResult = { ...solved, ...(view ? { view } : {}), elapsed: performance.now() - t0 };
+    const transfer: Transferable[] = view ? viewBuffers(view) : [];
+    for (const v of [value.uv, value.seam_edges, value.glb, value.obj, value.metrics?.per_face_distortion]) {
       if (v && ArrayBuffer.isView(v) && v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
     }
     return { value, transfer };
   }
   const r = s.place_cones(req.features, req.alphaSmooth, req.miq, progress);
   return { value: { ...r, elapsed: performance.now() - t0 }, transfer: [] };
+}
+
+/**
+ * The display arrays of a solve result (see solve-view.ts), built here so the
+ * page only uploads them; null when the result has no UVs for every corner or
+ * building them fails (the page then builds them itself).
+ */
+function solveView(s: Session, r: SolveResult): SolveView | null {
+  try {
+    const indices = s.indices();
+    if (!(r.uv instanceof Float32Array) || r.uv.length !== indices.length * 2) return null;
+    const positions = s.positions();
+    const edges = s.edges();
+    const fe = faceEdges(indices, buildAdjacency(edges, positions.length / 3));
+    return buildSolveView({
+      positions, indices, edges, boundary: s.boundary_edges(), faceEdges: fe, uv: r.uv,
+      seamEdges: r.seam_edges ?? null, perFaceDistortion: r.metrics?.per_face_distortion ?? null,
+    });
+  } catch (e) {
+    console.warn(`conemap: building the solve view in the worker failed: ${errorMessage(e)}`);
+    return null;
+  }
 }
 
 async function handle(req: Request): Promise<void> {
