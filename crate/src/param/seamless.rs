@@ -53,7 +53,9 @@ struct System {
     constraints: Vec<Triplet>,
     n_rows: usize,
     kkt: Kkt,
-    solver: LdltSolver,
+    /// The factorization; released (`None`) before the injective refinement,
+    /// which factors a system of its own.
+    solver: Option<LdltSolver>,
 }
 
 impl System {
@@ -77,6 +79,11 @@ impl System {
         t
     }
 
+    /// The factorization (an error once released).
+    fn solver(&self) -> Result<&LdltSolver, ParamError> {
+        self.solver.as_ref().ok_or(ParamError::NotFinite { what: "released factorization" })
+    }
+
     /// Global step: solves (23) for the target rotations `r` (rows in the face frame).
     fn solve(&self, weights: &[f64], r: &[[[f64; 2]; 2]]) -> Result<Vec<[f64; 2]>, ParamError> {
         let mut rhs = vec![0.0; self.n_unknowns + self.n_rows];
@@ -88,7 +95,7 @@ impl System {
                 }
             }
         }
-        let x = self.solver.solve(&rhs)?;
+        let x = self.solver()?.solve(&rhs)?;
         if x.iter().any(|v| !v.is_finite()) {
             return Err(ParamError::NotFinite { what: "global solve" });
         }
@@ -109,7 +116,8 @@ impl System {
     fn refactor(&mut self, weights: &[f64]) -> Result<(), ParamError> {
         let a = Self::a_triplets(&self.elements, weights);
         self.kkt.refill(&a, &self.constraints)?;
-        self.solver.factorize(&self.kkt.values)?;
+        let values = &self.kkt.values;
+        self.solver.as_mut().ok_or(ParamError::NotFinite { what: "released factorization" })?.factorize(values)?;
         Ok(())
     }
 
@@ -270,7 +278,7 @@ pub fn solve(
         SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..SolverOptions::default() },
     )?;
     solver.factorize(&kkt.values)?;
-    let sys = System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver };
+    let sys = System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver: Some(solver) };
     let mut sys = sys;
 
     // Poisson (23) with the field's target Jacobians (B.1).
@@ -358,6 +366,9 @@ pub fn solve(
     }
     let mut refine_iterations = 0;
     if best_flips == 0 && options.refine.max_iterations > 0 {
+        // Free the ARAP factorization first: the refinement factors its own
+        // (larger) system, and peak memory matters in the browser.
+        sys.solver = None;
         if let Some((x, iterations)) = refine(&sys, &sys.unknowns_of(&best_uv), &options.refine, progress) {
             let refined = sys.wedges_of(&x);
             // The refinement minimises a surrogate (ARAP + barrier): keep its
