@@ -33,7 +33,6 @@ declare global {
       visibleEdge(): number;
       /** Edge id a click at (x, y) would toggle; -1 when none. */
       edgeAt(x: number, y: number): number;
-      /** Later runs add stand-in UVs (fake-uv.ts) when the build has no `solve`, to exercise the UV display. */
     };
   }
 }
