@@ -3,7 +3,7 @@
 //! (paper section 4: "we cut the mesh along feature curves converting each
 //! curve into two boundary curves").
 
-use crate::mesh::{TriMesh, NONE};
+use crate::mesh::{TriMesh, UnionFind, NONE};
 use crate::operators;
 use std::collections::HashMap;
 use std::fmt;
@@ -149,14 +149,7 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
     let is_cut = |e: u32| features.contains(e) && mesh.edge_vertices(e).iter().any(|&v| splits(v));
     // Union corners (3 f + k) across every interior non-feature edge.
     let n_corners = 3 * mesh.n_faces();
-    let mut parent: Vec<u32> = (0..n_corners as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            parent[x as usize] = parent[parent[x as usize] as usize];
-            x = parent[x as usize];
-        }
-        x
-    }
+    let mut corners = UnionFind::new(n_corners);
     for e in 0..mesh.n_edges() as u32 {
         if is_cut(e) || mesh.is_boundary_edge(e) {
             continue;
@@ -166,8 +159,7 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
         let (ht, hh) = (h, 3 * (h / 3) + (h % 3 + 1) % 3);
         let (tt, th) = (t, 3 * (t / 3) + (t % 3 + 1) % 3);
         for (a, b) in [(ht, th), (hh, tt)] {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            parent[ra as usize] = rb;
+            corners.union(a, b);
         }
     }
     let mut new_id = vec![NONE; n_corners];
@@ -176,7 +168,7 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
     for (f, tri) in mesh.faces().iter().enumerate() {
         let mut out = [0u32; 3];
         for k in 0..3 {
-            let r = find(&mut parent, (3 * f + k) as u32) as usize;
+            let r = corners.find((3 * f + k) as u32) as usize;
             if new_id[r] == NONE {
                 new_id[r] = original_vertex.len() as u32;
                 original_vertex.push(tri[k]);
@@ -307,7 +299,7 @@ pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refin
     }
     let face_origin = |face: u32| current.as_ref().map_or(face, |r| r.original_face[face as usize]);
     let mut positions = m.positions().to_vec();
-    let mut triangles = Vec::with_capacity(m.n_faces() + 2 * vertices.len() * 8);
+    let mut triangles = Vec::with_capacity(m.n_faces() + 2 * marked.iter().filter(|&&x| x).count());
     let mut parent_face = Vec::with_capacity(triangles.capacity());
     let mut inserted = 0;
     for face in 0..m.n_faces() as u32 {

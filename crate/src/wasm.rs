@@ -149,7 +149,7 @@ impl MeshSession {
     /// Places cones and computes the seamless aligned map (the whole method).
     /// Returns the `place_cones` fields plus `uv` (Float32Array, 2 per input
     /// face corner `3 f + k`), `seam_edges` (input edge ids), `metrics`
-    /// (with `per_face_distortion`), `timings`, `split_edges`, `glb`
+    /// (with `per_face_distortion`), `timings`, `inserted_vertices` (by the refinement), `glb`
     /// (Uint8Array) and `obj` (string) of the solved mesh.
     pub fn solve(
         &self,
@@ -190,7 +190,7 @@ impl MeshSession {
         set(&m, "per_face_distortion", &Float32Array::from(&per_face[..]).into())?;
         set(&out, "metrics", &metrics)?;
         set(&out, "param_timings", &to_js(&sol.param.timings)?)?;
-        set(&out, "split_edges", &(sol.splits as f64).into())?;
+        set(&out, "inserted_vertices", &(sol.splits as f64).into())?;
         // Exports of the solved mesh (with any split edges), exactly.
         let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
         let mut input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &sol.param.uv)

@@ -531,7 +531,7 @@ export class Editor {
         if (typeof v === 'number') rows.push([`Time: ${k.replace(/_/g, ' ')} (UV)`, `${(v * 1000).toFixed(0)} ms`]);
       }
     }
-    const splits = (r as { split_edges?: number }).split_edges;
+    const splits = (r as { inserted_vertices?: number }).inserted_vertices;
     if (typeof splits === 'number' && splits > 0) rows.push(['Inserted vertices (refinement)', fmtInt(splits)]);
     rows.push(['Time in worker', `${r.elapsed.toFixed(0)} ms`]);
     const list = definitionList(rows);

@@ -74,7 +74,6 @@ function openMesh(req: Extract<Request, { type: 'import' }>): { value: unknown; 
     edges = uniqueEdges(indices, vertexCount);
   }
   const t2 = performance.now();
-  // Only builds without `solve` need the copies (for the test stand-in UVs).
   post({ id, type: 'progress', stage: 'transferring' });
   const result: ImportResult = {
     positions,

@@ -398,7 +398,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
 
     if let Some(path) = args.value("--report") {
         let mut report = cones_json(mesh, features, &options, placement);
-        report["split_edges"] = serde_json::json!(solution.splits);
+        report["inserted_vertices"] = serde_json::json!(solution.splits);
         report["metrics"] = serde_json::json!(result.metrics);
         report["seam_edges"] = serde_json::json!(result.seam_edges.len());
         report["arap_iterations"] = serde_json::json!(result.arap_iterations);

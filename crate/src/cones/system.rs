@@ -9,6 +9,7 @@
 //! * fix `e`: `t_e p_e = t_e c_e` (`t_e = 1` once `p_e` is rounded);
 //! * pin: boundary vertex rows `sum_e sigma_ve p_e = k_v - 4 j_v` that
 //!   peeling could not turn into fixes.
+//!
 //! Objective (eq. 18 with the harmonic minimality (17) as a lexicographic
 //! weight, see docs/cone-placement.md): `phiᵀ(alpha L + M/A)phi + W hᵀ M_1 h`;
 //! MIQ emulation: `alpha (phiᵀ L phi + hᵀ M_1 h) + phiᵀ M phi / A`.
@@ -333,10 +334,8 @@ impl<'a> ComponentSystem<'a> {
 
     /// Refactors after fixes changed and solves.
     fn refactor_and_solve(&mut self) -> Result<(), ConeError> {
-        for (g, fx) in self.fixed.iter().enumerate() {
-            self.kkt.values[self.fix_slots[g]] = if fx.is_some() { 1.0 } else { 0.0 };
-            self.kkt.values[self.fix_diag_slots[g]] = if fx.is_some() { 0.0 } else { -1.0 };
-            self.constraint_rhs[self.row_fix + g] = fx.unwrap_or(0) as f64;
+        for g in 0..self.fixed.len() {
+            self.write_fix_row(g);
         }
         // Escalating regularization: a pivot that overflows under the default
         // delta (seen on 200 k-face meshes) is retried with a larger one;
@@ -368,22 +367,17 @@ impl<'a> ComponentSystem<'a> {
             self.residual = info.relative_residual;
             return Ok(());
         }
-        let options = self.solver.options();
-        // The outer refinement below runs against the exact matrix; the
-        // inner solves with the stale factor need no refinement of their own.
-        self.solver.set_options(SolverOptions { max_refinement_steps: 0, accept_residual: f64::INFINITY, ..options });
-        let result = self.bordered_solve(&b, options);
-        self.solver.set_options(options);
-        result?;
-        if self.residual > options.accept_residual {
+        self.bordered_solve(&b)?;
+        if self.residual > self.solver.options().accept_residual {
             return self.refactor_and_solve();
         }
         Ok(())
     }
 
     /// [`Self::solve`] with bordered fixes: iterative refinement of the
-    /// bordered solve against the exact matrix, up to `options`' limits.
-    fn bordered_solve(&mut self, b: &[f64], options: SolverOptions) -> Result<(), ConeError> {
+    /// bordered solve against the exact matrix, up to the solver options' limits.
+    fn bordered_solve(&mut self, b: &[f64]) -> Result<(), ConeError> {
+        let options = self.solver.options();
         let bnorm = b.iter().map(|v| v * v).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
         let mut x = self.border.solve(&self.solver, b)?;
         let mut kx = vec![0.0; b.len()];
@@ -402,25 +396,29 @@ impl<'a> ComponentSystem<'a> {
         Ok(())
     }
 
+    /// Writes fix row `g` into the KKT values and right-hand side: active
+    /// (`p_g = c_g`) once `p_g` is fixed, else decoupled (diagonal `-1`).
+    fn write_fix_row(&mut self, g: usize) {
+        let fx = self.fixed[g];
+        self.kkt.values[self.fix_slots[g]] = if fx.is_some() { 1.0 } else { 0.0 };
+        self.kkt.values[self.fix_diag_slots[g]] = if fx.is_some() { 0.0 } else { -1.0 };
+        self.constraint_rhs[self.row_fix + g] = fx.unwrap_or(0) as f64;
+    }
+
     /// Makes the fixes of `newly` (indices into `p`) active: by bordered
     /// updates while they are few, else by refactorizing; then solves.
     fn activate_and_solve(&mut self, newly: &[usize]) -> Result<(), ConeError> {
         for &g in newly {
-            let fx = self.fixed[g].expect("activated fixes have values");
-            self.kkt.values[self.fix_slots[g]] = 1.0;
-            self.kkt.values[self.fix_diag_slots[g]] = 0.0;
-            self.constraint_rhs[self.row_fix + g] = fx as f64;
+            self.write_fix_row(g);
         }
         let limit = MAX_BORDER.min(BORDER_BUDGET / self.kkt.pattern.dim().max(1));
         if self.border.len() + newly.len() > limit {
             return self.refactor_and_solve();
         }
         let (p0, fix0) = (self.p0(), self.n + self.row_fix);
-        let options = self.solver.options();
-        self.solver.set_options(SolverOptions { max_refinement_steps: 0, accept_residual: f64::INFINITY, ..options });
-        let pushed: Result<(), SolveError> = newly.iter().try_for_each(|&g| self.border.push(&self.solver, p0 + g, fix0 + g));
-        self.solver.set_options(options);
-        pushed?;
+        for &g in newly {
+            self.border.push(&self.solver, p0 + g, fix0 + g)?;
+        }
         self.solve()
     }
 

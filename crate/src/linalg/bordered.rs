@@ -9,7 +9,9 @@
 //! `Z = K0⁻¹ B` (one solve per activation, cached) and `S = Bᵀ Z`, a solve
 //! `K [z; λ] = [r; c]` is `y = K0⁻¹ r`, `λ = S⁻¹ (Bᵀ y − c)`, `z = y − Z λ`.
 //! This costs one solve plus `O(n k)` per right-hand side, against one
-//! factorization, so it pays while `k` is small.
+//! factorization, so it pays while `k` is small. All solves use the factor
+//! alone ([`LdltSolver::solve_unrefined`]): the caller refines against the
+//! true matrix.
 
 use super::cholesky::LdltSolver;
 use super::SolveError;
@@ -49,7 +51,7 @@ impl FixBorder {
         let n = solver.pattern().dim();
         let mut e = vec![0.0; n];
         e[var] = 1.0;
-        self.columns.push(solver.solve(&e)?);
+        self.columns.push(solver.solve_unrefined(&e)?);
         self.fixes.push((var, row));
         let k = self.fixes.len();
         let s = DMatrix::from_fn(k, k, |i, j| self.columns[j][self.fixes[i].0]);
@@ -61,13 +63,13 @@ impl FixBorder {
     /// of `K`; the entries at the held fix rows are the fixed values).
     pub fn solve(&self, solver: &LdltSolver, b: &[f64]) -> Result<Vec<f64>, SolveError> {
         let Some(schur) = &self.schur else {
-            return solver.solve(b);
+            return solver.solve_unrefined(b);
         };
         let mut r = b.to_vec();
         for &(_, row) in &self.fixes {
             r[row] = 0.0;
         }
-        let mut x = solver.solve(&r)?;
+        let mut x = solver.solve_unrefined(&r)?;
         let rhs = DVector::from_iterator(self.fixes.len(), self.fixes.iter().map(|&(var, row)| x[var] - b[row]));
         let lambda = schur.solve(&rhs).ok_or(SolveError::NotFinite { what: "bordered Schur complement" })?;
         for (z, &l) in self.columns.iter().zip(lambda.iter()) {

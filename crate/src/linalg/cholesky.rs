@@ -425,6 +425,29 @@ impl<K> SparseCholesky<K> {
         self.core.factorize(&v)
     }
 
+    /// Solves with the (regularized) factor alone: no refinement and no
+    /// residual, for callers that refine against a matrix of their own.
+    /// Errors if not factorized, on a bad length or on non-finite values.
+    pub fn solve_unrefined(&self, rhs: &[f64]) -> Result<Vec<f64>, SolveError> {
+        let core = &self.core;
+        if !core.factorized {
+            return Err(SolveError::NotFactorized);
+        }
+        let n = core.pattern.dim();
+        if rhs.len() != n {
+            return Err(SolveError::DimensionMismatch { what: "right-hand side", expected: n, found: rhs.len() });
+        }
+        if rhs.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NotFinite { what: "right-hand side" });
+        }
+        let mut x = rhs.to_vec();
+        core.raw_solve(&mut x, 1)?;
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NotFinite { what: "solution" });
+        }
+        Ok(x)
+    }
+
     /// Solves `K x = rhs` (refinement until relative residual < `tolerance` or
     /// `max_refinement_steps`); errors if not factorized or not converged.
     pub fn solve(&self, rhs: &[f64]) -> Result<Vec<f64>, SolveError> {

@@ -21,6 +21,7 @@ pub use subdivide::subdivide_midpoint;
 pub use trimesh::{Outgoing, TriMesh, NONE};
 pub use validate::{analyze, analyze_by_index, ZERO_AREA_REL};
 pub use weld::{weld, Welded, NO_VERTEX};
+pub(crate) use topology::UnionFind;
 
 /// Figures of an imported mesh, computed even when the mesh has problems.
 ///

@@ -116,6 +116,7 @@ pub(crate) fn he_head(tris: &[[u32; 3]], h: u32) -> u32 {
 
 /// Union-find with path halving and union by index (smaller root wins, so
 /// roots are the first element of each set).
+/// Disjoint sets over `0..n` (path halving; the smaller root wins a union).
 pub(crate) struct UnionFind {
     parent: Vec<u32>,
 }

@@ -46,14 +46,18 @@ impl TriMesh {
     /// unreferenced vertices are dropped silently.
     pub fn from_raw(raw: &RawMesh) -> Result<TriMesh, Vec<Problem>> {
         let a = analyze_raw(raw);
-        let pinches: Vec<Problem> =
-            a.report.problems.iter().filter(|p| matches!(p, Problem::NonManifoldVertex { .. })).cloned().collect();
-        if pinches.is_empty() || a.report.problems.iter().any(Problem::is_blocking) {
+        let vertices: Vec<u32> = a
+            .report
+            .problems
+            .iter()
+            .filter_map(|p| if let Problem::NonManifoldVertex { vertex, .. } = p { Some(*vertex) } else { None })
+            .collect();
+        if vertices.is_empty() || a.report.problems.iter().any(Problem::is_blocking) {
             return Self::from_analysis(a);
         }
         // Repair: one vertex per fan; the report keeps naming the pinches.
-        let vertices: Vec<u32> =
-            pinches.iter().filter_map(|p| if let Problem::NonManifoldVertex { vertex, .. } = p { Some(*vertex) } else { None }).collect();
+        let pinches: Vec<Problem> =
+            a.report.problems.iter().filter(|p| matches!(p, Problem::NonManifoldVertex { .. })).cloned().collect();
         let mut split = analyze_welded(raw, split_pinches(&a.welded, &vertices));
         split.report.non_manifold_vertices = pinches.len();
         split.report.problems.extend(pinches);

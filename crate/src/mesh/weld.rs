@@ -3,6 +3,7 @@
 //! Connectivity of an imported mesh comes from positions, not from the file's
 //! vertex indices (files routinely split vertices along UV or normal seams).
 
+use super::topology::UnionFind;
 use super::RawMesh;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hash, Hasher};
@@ -105,7 +106,7 @@ pub fn close_cracks(w: &Welded, boundary: &[u32], joined: impl Fn(u32, u32) -> b
     if !(tol > 0.0 && tol.is_finite()) {
         return None;
     }
-    let cell = |p: [f64; 3]| p.map(|x| ((x - 0.0) / tol).floor() as i64);
+    let cell = |p: [f64; 3]| p.map(|x| (x / tol).floor() as i64);
     let mut grid: HashMap<[i64; 3], Vec<u32>, BuildHasherDefault<FxHasher>> = HashMap::default();
     let mut sorted = boundary.to_vec();
     sorted.sort_unstable();
@@ -176,34 +177,21 @@ pub fn split_pinches(w: &Welded, pinches: &[u32]) -> Welded {
     for v in keys {
         let faces = &incident[&v];
         // Union faces sharing an edge (v, x).
-        let mut parent: Vec<usize> = (0..faces.len()).collect();
-        fn find(p: &mut [usize], mut i: usize) -> usize {
-            while p[i] != i {
-                p[i] = p[p[i]];
-                i = p[i];
-            }
-            i
-        }
-        let mut by_other: HashMap<u32, usize, BuildHasherDefault<FxHasher>> = HashMap::default();
+        let mut fans = UnionFind::new(faces.len());
+        let mut by_other: HashMap<u32, u32, BuildHasherDefault<FxHasher>> = HashMap::default();
         for (i, &f) in faces.iter().enumerate() {
-            for &x in &w.triangles[f] {
-                if x == v {
-                    continue;
-                }
+            for &x in w.triangles[f].iter().filter(|&&x| x != v) {
                 match by_other.get(&x) {
-                    Some(&j) => {
-                        let (a, b) = (find(&mut parent, i), find(&mut parent, j));
-                        parent[a] = b;
-                    }
+                    Some(&j) => fans.union(i as u32, j),
                     None => {
-                        by_other.insert(x, i);
+                        by_other.insert(x, i as u32);
                     }
                 }
             }
         }
-        let mut copy_of_root: HashMap<usize, u32, BuildHasherDefault<FxHasher>> = HashMap::default();
+        let mut copy_of_root: HashMap<u32, u32, BuildHasherDefault<FxHasher>> = HashMap::default();
         for (i, &f) in faces.iter().enumerate() {
-            let root = find(&mut parent, i);
+            let root = fans.find(i as u32);
             let next = copy_of_root.len();
             let id = *copy_of_root.entry(root).or_insert_with(|| {
                 if next == 0 {

@@ -12,7 +12,7 @@
 use super::field::CrossField;
 use super::ParamError;
 use crate::cones::ConePlacement;
-use crate::mesh::TriMesh;
+use crate::mesh::{TriMesh, UnionFind};
 
 /// A maximal chain of seam edges with one transition
 /// `f_g = Rot(-m pi/2) f_f + t` (B.2), `f` the face of each halfedge
@@ -95,14 +95,7 @@ pub fn cut_graph(mesh: &TriMesh, placement: &ConePlacement, field: &CrossField) 
     let seam_edges: Vec<u32> = (0..mesh.n_edges() as u32).filter(|&e| is_seam[e as usize]).collect();
 
     // Wedges: union corners across interior non-seam edges.
-    let mut parent: Vec<u32> = (0..3 * nf as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
+    let mut corners = UnionFind::new(3 * nf);
     for e in 0..mesh.n_edges() as u32 {
         if is_seam[e as usize] || mesh.is_boundary_edge(e) {
             continue;
@@ -113,15 +106,14 @@ pub fn cut_graph(mesh: &TriMesh, placement: &ConePlacement, field: &CrossField) 
             return Err(ParamError::UncutSingularity { edge: e, matching: m });
         }
         for (a, b) in [(h, mesh.next(t)), (mesh.next(h), t)] {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            parent[ra as usize] = rb;
+            corners.union(a, b);
         }
     }
     let mut id = vec![u32::MAX; 3 * nf];
     let mut wedge = vec![0u32; 3 * nf];
     let mut n_wedges = 0usize;
     for c in 0..3 * nf {
-        let r = find(&mut parent, c as u32) as usize;
+        let r = corners.find(c as u32) as usize;
         if id[r] == u32::MAX {
             id[r] = n_wedges as u32;
             n_wedges += 1;

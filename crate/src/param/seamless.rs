@@ -14,8 +14,8 @@ use super::metrics;
 use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
-use crate::linalg::{Kkt, LdltSolver, SolverOptions, Triplet};
-use crate::mesh::TriMesh;
+use crate::linalg::{Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
+use crate::mesh::{TriMesh, UnionFind};
 
 /// Repair rounds tried without lowering the number of folds before giving up.
 const REPAIR_PATIENCE: usize = 16;
@@ -79,9 +79,9 @@ impl System {
         t
     }
 
-    /// The factorization (an error once released).
+    /// The factorization ([`SolveError::NotFactorized`] once released).
     fn solver(&self) -> Result<&LdltSolver, ParamError> {
-        self.solver.as_ref().ok_or(ParamError::NotFinite { what: "released factorization" })
+        self.solver.as_ref().ok_or(ParamError::Solve(SolveError::NotFactorized))
     }
 
     /// Global step: solves (23) for the target rotations `r` (rows in the face frame).
@@ -116,8 +116,8 @@ impl System {
     fn refactor(&mut self, weights: &[f64]) -> Result<(), ParamError> {
         let a = Self::a_triplets(&self.elements, weights);
         self.kkt.refill(&a, &self.constraints)?;
-        let values = &self.kkt.values;
-        self.solver.as_mut().ok_or(ParamError::NotFinite { what: "released factorization" })?.factorize(values)?;
+        let solver = self.solver.as_mut().ok_or(ParamError::Solve(SolveError::NotFactorized))?;
+        solver.factorize(&self.kkt.values)?;
         Ok(())
     }
 
@@ -465,14 +465,7 @@ fn arap(
 /// also removes the rows they would make redundant.
 fn unknowns(mesh: &TriMesh, field: &CrossField, cut: &CutGraph) -> ([Vec<usize>; 2], usize) {
     let nw = cut.n_wedges;
-    let mut uf: [Vec<u32>; 2] = [(0..nw as u32).collect(), (0..nw as u32).collect()];
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
+    let mut uf = [UnionFind::new(nw), UnionFind::new(nw)];
     for h in 0..3 * mesh.n_faces() as u32 {
         let c = field.isoline[h as usize];
         if c == NO_ISOLINE {
@@ -480,15 +473,14 @@ fn unknowns(mesh: &TriMesh, field: &CrossField, cut: &CutGraph) -> ([Vec<usize>;
         }
         let c = c as usize;
         let (a, b) = (cut.wedge[h as usize], cut.wedge[mesh.next(h) as usize]);
-        let (ra, rb) = (find(&mut uf[c], a), find(&mut uf[c], b));
-        uf[c][ra as usize] = rb;
+        uf[c].union(a, b);
     }
     let mut n = 0;
     let mut var: [Vec<usize>; 2] = [vec![usize::MAX; nw], vec![usize::MAX; nw]];
     for c in 0..2 {
         let mut id = vec![usize::MAX; nw];
         for w in 0..nw as u32 {
-            let r = find(&mut uf[c], w) as usize;
+            let r = uf[c].find(w) as usize;
             if id[r] == usize::MAX {
                 id[r] = n;
                 n += 1;
