@@ -404,6 +404,8 @@ fn solve(args: &Args) -> Result<(), Failure> {
         report["arap_iterations"] = serde_json::json!(result.arap_iterations);
         report["flips_before_repair"] = serde_json::json!(result.flips_before_repair);
         report["flips_fixed"] = serde_json::json!(result.flips_fixed);
+        report["repair_rounds"] = serde_json::json!(result.repair_rounds);
+        report["refine_iterations"] = serde_json::json!(result.refine_iterations);
         report["output"] = serde_json::json!({
             "path": out,
             "format": format!("{format:?}").to_ascii_lowercase(),

@@ -24,6 +24,8 @@ use crate::vec3;
 use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::PI;
 
+mod moves;
+
 /// Weight of the harmonic norm in the lexicographic objective.
 const HARMONIC_WEIGHT: f64 = 1e4;
 /// Proximal weight on the free integers (see the assembly).
@@ -33,11 +35,14 @@ pub const MERGE_TOLERANCE: f64 = 0.01;
 /// Total rounding allowed per batch (Algorithm 1: below 0.5).
 const ROUNDING_BATCH: f64 = 0.5;
 /// Relative residual the solves of intermediate rounding rounds stop at.
-const ROUNDING_TOLERANCE: f64 = 1e-9;
+const ROUNDING_TOLERANCE: f64 = 1e-6;
 /// Memory budget (in f64s) for the cached columns of the bordered updates.
 const BORDER_BUDGET: usize = 8 << 20;
 /// Most fixes handled by bordered updates before the KKT is refactorized.
 const MAX_BORDER: usize = 48;
+/// A round fixing more than this refactorizes instead of bordering: one
+/// bordered column costs a tenth to a twentieth of a factorization and solve.
+const MAX_BORDER_BATCH: usize = 16;
 /// Largest relative LDLᵀ regularization tried before a solve failure is reported.
 const MAX_DELTA: f64 = 1e-4;
 
@@ -350,16 +355,27 @@ impl<'a> ComponentSystem<'a> {
                 )) if options.delta < MAX_DELTA => {
                     self.solver.set_options(SolverOptions { delta: options.delta * 100.0, ..options });
                 }
+                Ok(()) => {
+                    // Rounds until the next factorization change only held fix rows.
+                    self.border.set_base(self.rhs(), self.x.clone());
+                    return Ok(());
+                }
                 other => return other,
             }
         }
     }
 
+    /// The KKT right-hand side `[0; constraint values]`.
+    fn rhs(&self) -> Vec<f64> {
+        let mut b = vec![0.0; self.n];
+        b.extend_from_slice(&self.constraint_rhs);
+        b
+    }
+
     /// Solves with the current factorization (and the bordered fixes made
     /// since) and right-hand side, refining against the exact matrix.
     pub(crate) fn solve(&mut self) -> Result<(), ConeError> {
-        let mut b = vec![0.0; self.n];
-        b.extend_from_slice(&self.constraint_rhs);
+        let b = self.rhs();
         if self.border.is_empty() {
             let (x, info) = self.solver.solve_with_info(&b)?;
             self.refinement_steps += info.refinement_steps;
@@ -368,7 +384,8 @@ impl<'a> ComponentSystem<'a> {
             return Ok(());
         }
         self.bordered_solve(&b)?;
-        if self.residual > self.solver.options().accept_residual {
+        let options = self.solver.options();
+        if self.residual > options.accept_residual.max(options.tolerance) {
             return self.refactor_and_solve();
         }
         Ok(())
@@ -412,13 +429,12 @@ impl<'a> ComponentSystem<'a> {
             self.write_fix_row(g);
         }
         let limit = MAX_BORDER.min(BORDER_BUDGET / self.kkt.pattern.dim().max(1));
-        if self.border.len() + newly.len() > limit {
+        if self.border.len() + newly.len() > limit || newly.len() > MAX_BORDER_BATCH {
             return self.refactor_and_solve();
         }
         let (p0, fix0) = (self.p0(), self.n + self.row_fix);
-        for &g in newly {
-            self.border.push(&self.solver, p0 + g, fix0 + g)?;
-        }
+        let fixes: Vec<(usize, usize)> = newly.iter().map(|&g| (p0 + g, fix0 + g)).collect();
+        self.border.push(&self.solver, &fixes)?;
         self.solve()
     }
 
@@ -438,6 +454,16 @@ impl<'a> ComponentSystem<'a> {
         // factorization of the final matrix.
         if self.border.is_empty() {
             self.solve()
+        } else {
+            self.refactor_and_solve()
+        }
+    }
+
+    /// Refactorizes if bordered fixes are pending, so that the factor holds
+    /// the current matrix (needed by plain factor solves).
+    fn settle_border(&mut self) -> Result<(), ConeError> {
+        if self.border.is_empty() {
+            Ok(())
         } else {
             self.refactor_and_solve()
         }
@@ -481,10 +507,7 @@ impl<'a> ComponentSystem<'a> {
     /// The cone index of every local vertex: `k_v = 4 j_v + sum sigma p`
     /// (all `p` must be fixed).
     pub fn vertex_k(&self) -> Vec<i64> {
-        self.cycles
-            .iter()
-            .map(|c| 4 * c.j + c.g.iter().map(|&(g, s)| s as i64 * self.fixed[g as usize].unwrap_or(0)).sum::<i64>())
-            .collect()
+        (0..self.cycles.len()).map(|i| self.vertex_k_at(i)).collect()
     }
 
     /// `phi` per local vertex from the last solve.
@@ -505,7 +528,7 @@ impl<'a> ComponentSystem<'a> {
 
     /// `phiᵀ M phi / A`: the area-weighted mean of phi² (the distortion proxy).
     pub fn phi_norm2(&self) -> f64 {
-        self.phi().iter().zip(&self.area).map(|(p, a)| p * p * a).sum::<f64>() / self.total_area
+        self.phi_norm2_at(&self.x, None)
     }
 
     /// `phiᵀ (alpha L + M/A) phi` with `alpha` as given.
@@ -530,279 +553,31 @@ impl<'a> ComponentSystem<'a> {
         &self.defect
     }
 
-    /// Moves cone index `amount` from local vertex `from` to `to` by changing
-    /// the fixed `p` along the `T_p` path (leftovers are never on it);
-    /// only the right-hand side changes.
-    pub(crate) fn transfer(&mut self, from: usize, to: usize, amount: i64) {
-        let (a, b) = (self.tree.vertices[from], self.tree.vertices[to]);
-        let path = self.tree.primal_path(self.mesh, a, b);
-        let mut x = a;
-        for (e, _) in path {
-            let [u, w] = self.mesh.edge_vertices(e);
-            let next = if u == x { w } else { u };
-            let g = self.tree.g_index[e as usize];
-            let s = self.cycles[self.local[x as usize] as usize]
-                .g
-                .iter()
-                .find(|(gg, _)| *gg == g)
-                .map(|&(_, s)| s as i64)
-                .expect("T_p edges are G edges of both end vertices");
-            let p = self.fixed[g as usize].as_mut().expect("all p fixed before cone moves");
-            *p -= amount * s;
-            self.constraint_rhs[self.row_fix + g as usize] = *p as f64;
-            x = next;
-        }
-    }
-
-    /// First-order sensitivity of `phiᵀ M phi / A` to moving cone index:
-    /// returns `Phi` per local vertex such that moving `a` quarter turns from
-    /// `u` to `w` (along `T_p`, as [`Self::transfer`] does) changes the
-    /// energy by about `2 a (Phi[w] - Phi[u])`. One solve with the current
-    /// factorization: `y = K⁻¹ [D phi; 0]`, read on the fix rows.
-    fn move_potential(&self) -> Result<Vec<f64>, ConeError> {
-        let nv = self.tree.vertices.len();
-        let mut r = vec![0.0; self.n + self.constraint_rhs.len()];
-        for i in 0..nv {
-            r[i] = self.area[i] / self.total_area * self.x[i];
-        }
-        let y = self.solver.solve(&r)?;
-        let mut order: Vec<usize> = (0..nv).collect();
-        order.sort_by_key(|&i| self.tree.primal_depth[self.tree.vertices[i] as usize]);
-        let mut phi = vec![0.0; nv];
-        for i in order {
-            let h = self.tree.primal_parent_he[self.tree.vertices[i] as usize];
-            if h == NONE {
-                continue; // the root of T_p
-            }
-            let parent = self.local[self.mesh.tail(h) as usize] as usize;
-            let g = self.tree.g_index[self.mesh.edge(h) as usize];
-            let sigma = self.cycles[i].g.iter().find(|(gg, _)| *gg == g).map_or(0, |&(_, s)| s);
-            phi[i] = phi[parent] + y[self.n + self.row_fix + g as usize] * sigma as f64;
-        }
-        Ok(phi)
-    }
-
-    /// Cone-location optimization (section 5.3): moves an interior cone to
-    /// a neighbouring interior vertex when that lowers `phiᵀ M phi / A`,
-    /// until no move helps or `max_passes` passes. Candidates are ranked by
-    /// the first-order change ([`Self::move_potential`]) and the two most
-    /// promising per cone are evaluated exactly; after the first pass only
-    /// cones within two rings of a moved cone are reconsidered. Returns the
-    /// moves made.
-    pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
-        const EXACT_TRIES: usize = 2;
-        let mut moves = 0;
-        let mut current = self.phi_norm2();
-        let nv = self.tree.vertices.len();
-        // Cones to (re)consider: all at first, then those near a moved cone.
-        let mut dirty = vec![true; nv];
-        for pass in 0..max_passes {
-            progress(pass);
-            let potential = self.move_potential()?;
-            let k = self.vertex_k();
-            let cones: Vec<usize> = (0..nv)
-                .filter(|&i| k[i] != 0 && dirty[i] && !self.mesh.is_boundary_vertex(self.tree.vertices[i]))
-                .collect();
-            dirty.iter_mut().for_each(|d| *d = false);
-            let mut moved = 0;
-            for i in cones {
-                let ki = self.vertex_k()[i];
-                if ki == 0 {
-                    continue;
-                }
-                let v = self.tree.vertices[i];
-                let mut candidates: Vec<(f64, usize)> = self
-                    .mesh
-                    .one_ring(v)
-                    .filter(|&w| !self.mesh.is_boundary_vertex(w))
-                    .map(|w| self.local[w as usize] as usize)
-                    .map(|j| (2.0 * ki as f64 * (potential[j] - potential[i]), j))
-                    .filter(|&(estimate, _)| estimate < -1e-9 * current)
-                    .collect();
-                candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let mut best: Option<(f64, usize, Vec<f64>)> = None;
-                let before = self.x.clone();
-                for &(_, j) in candidates.iter().take(EXACT_TRIES) {
-                    self.transfer(i, j, ki);
-                    self.solve()?;
-                    let e = self.phi_norm2();
-                    if e < current * (1.0 - 1e-9) && best.as_ref().map_or(true, |b| e < b.0) {
-                        best = Some((e, j, std::mem::take(&mut self.x)));
-                    }
-                    self.transfer(j, i, ki);
-                }
-                self.x = before;
-                if let Some((e, j, x)) = best {
-                    self.transfer(i, j, ki);
-                    self.x = x;
-                    current = e;
-                    moves += 1;
-                    moved += 1;
-                    let w = self.tree.vertices[j];
-                    dirty[j] = true;
-                    for a in self.mesh.one_ring(w) {
-                        dirty[self.local[a as usize] as usize] = true;
-                        for b in self.mesh.one_ring(a) {
-                            dirty[self.local[b as usize] as usize] = true;
-                        }
-                    }
-                }
-            }
-            if moved == 0 {
-                break;
-            }
-        }
-        self.solve()?;
-        Ok(moves)
-    }
-}
-
-impl ComponentSystem<'_> {
     /// The objective of the last solve: `phiᵀ(alpha L + M/A)phi` plus the
     /// harmonic term (lexicographic weight, or `alpha hᵀM_1h` for MIQ).
     pub fn objective(&self) -> f64 {
+        self.objective_at(&self.x, None)
+    }
+
+    /// The objective at `x + delta` (`delta` of the length of `x`, if given).
+    fn objective_at(&self, x: &[f64], delta: Option<&[f64]>) -> f64 {
+        let v = |i: usize| x[i] + delta.map_or(0.0, |d| d[i]);
         self.objective_terms
             .iter()
-            .map(|&(r, c, w)| if r == c { w * self.x[r] * self.x[c] } else { 2.0 * w * self.x[r] * self.x[c] })
+            .map(|&(r, c, w)| if r == c { w * v(r) * v(c) } else { 2.0 * w * v(r) * v(c) })
             .sum()
     }
 
-    /// Unit transfers that cancel every interior cone: each quarter turn of a
-    /// positive cone goes to the nearest negative cone with index left.
-    fn pairing(&self, cones: &[(usize, i64)]) -> Vec<(usize, usize, i64)> {
-        let pos = |i: usize| self.mesh.position(self.tree.vertices[i]);
-        let mut left: Vec<(usize, i64)> = cones.iter().filter(|c| c.1 < 0).copied().collect();
-        let mut moves = Vec::new();
-        for &(i, ki) in cones.iter().filter(|c| c.1 > 0) {
-            for _ in 0..ki {
-                let Some(best) = (0..left.len()).filter(|&n| left[n].1 < 0).min_by(|&a, &b| {
-                    let d = |n: usize| crate::vec3::norm(crate::vec3::sub(pos(i), pos(left[n].0)));
-                    d(a).total_cmp(&d(b))
-                }) else {
-                    break;
-                };
-                moves.push((i, left[best].0, 1));
-                left[best].1 += 1;
-            }
-        }
-        moves
+    /// `phiᵀ M phi / A` at `x + delta`.
+    fn phi_norm2_at(&self, x: &[f64], delta: Option<&[f64]>) -> f64 {
+        let v = |i: usize| x[i] + delta.map_or(0.0, |d| d[i]);
+        (0..self.area.len()).map(|i| v(i) * v(i) * self.area[i]).sum::<f64>() / self.total_area
     }
 
-    /// Interior cones as (local vertex, k).
-    fn interior_cones(&self) -> Vec<(usize, i64)> {
-        let k = self.vertex_k();
-        (0..k.len()).filter(|&i| k[i] != 0 && !self.mesh.is_boundary_vertex(self.tree.vertices[i])).map(|i| (i, k[i])).collect()
-    }
-
-    /// Clean-up of section 5.3 (after Myles & Zorin 2012): cancels pairs of
-    /// interior cones of opposite index one or two edges apart, unless that
-    /// raises the objective by more than [`MERGE_TOLERANCE`] (on coarse
-    /// meshes a close pair can carry a real rotation). Returns the pairs removed.
-    pub fn merge_close_pairs(&mut self) -> Result<usize, ConeError> {
-        let mut merged = 0;
-        let mut rejected: std::collections::HashSet<(usize, usize)> = Default::default();
-        let mut current = self.objective();
-        loop {
-            let cones = self.interior_cones();
-            let index: std::collections::HashMap<usize, i64> = cones.iter().copied().collect();
-            let mut pair = None;
-            'search: for &(i, ki) in &cones {
-                let v = self.tree.vertices[i];
-                for w in self.mesh.one_ring(v) {
-                    for x in std::iter::once(w).chain(self.mesh.one_ring(w)) {
-                        let j = self.local[x as usize] as usize;
-                        if j != i && index.get(&j) == Some(&-ki) && !rejected.contains(&(i, j)) {
-                            pair = Some((i, j, ki));
-                            break 'search;
-                        }
-                    }
-                }
-            }
-            let Some((i, j, ki)) = pair else { break };
-            self.transfer(i, j, ki);
-            self.solve()?;
-            let e = self.objective();
-            if e <= current * (1.0 + MERGE_TOLERANCE) {
-                current = e;
-                merged += 1;
-            } else {
-                self.transfer(j, i, ki);
-                rejected.insert((i, j));
-                rejected.insert((j, i));
-            }
-        }
-        self.solve()?;
-        Ok(merged)
-    }
-
-    /// Pair cancellation by descent on the objective (an extension of the
-    /// paper's clean-up to distant pairs): for each interior cone, tries
-    /// cancelling it against each of its `nearest` closest cones of opposite
-    /// index and keeps the best cancellation while the objective decreases.
-    /// Returns the number of pairs removed.
-    pub fn cancel_pairs(&mut self, nearest: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
-        let mut removed = 0;
-        let mut current = self.objective();
-        // Global candidate: when the interior indices sum to zero, all cones
-        // may cancel at once (a single pair's removal can cost energy while
-        // removing all of them lowers it, e.g. on a torus of revolution).
-        let cones = self.interior_cones();
-        if !cones.is_empty() && cones.iter().map(|c| c.1).sum::<i64>() == 0 {
-            let moves = self.pairing(&cones);
-            for &(i, j, a) in &moves {
-                self.transfer(i, j, a);
-            }
-            self.solve()?;
-            let e = self.objective();
-            if e < current * (1.0 - 1e-9) {
-                current = e;
-                removed += moves.len();
-            } else {
-                for &(i, j, a) in moves.iter().rev() {
-                    self.transfer(j, i, a);
-                }
-            }
-        }
-        loop {
-            progress(removed);
-            let cones = self.interior_cones();
-            let (mesh, vertices) = (self.mesh, self.tree.vertices.clone());
-            let pos = |i: usize| mesh.position(vertices[i]);
-            let mut best: Option<(f64, usize, usize, i64)> = None;
-            for &(i, ki) in &cones {
-                let mut partners: Vec<(f64, usize)> = cones
-                    .iter()
-                    .filter(|&&(j, kj)| kj == -ki && j != i)
-                    .map(|&(j, _)| {
-                        let (a, b) = (pos(i), pos(j));
-                        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2), j)
-                    })
-                    .collect();
-                partners.sort_by(|a, b| a.0.total_cmp(&b.0));
-                for &(_, j) in partners.iter().take(nearest) {
-                    if ki < 0 {
-                        continue; // each pair is tried once, from its positive cone
-                    }
-                    self.transfer(i, j, ki);
-                    self.solve()?;
-                    let e = self.objective();
-                    if e < current * (1.0 - 1e-9) && best.map_or(true, |b| e < b.0) {
-                        best = Some((e, i, j, ki));
-                    }
-                    self.transfer(j, i, ki);
-                }
-            }
-            match best {
-                Some((e, i, j, ki)) => {
-                    self.transfer(i, j, ki);
-                    current = e;
-                    removed += 1;
-                }
-                None => break,
-            }
-        }
-        self.solve()?;
-        Ok(removed)
+    /// The cone index of local vertex `i` (all `p` on its cycle fixed).
+    pub fn vertex_k_at(&self, i: usize) -> i64 {
+        let c = &self.cycles[i];
+        4 * c.j + c.g.iter().map(|&(g, s)| s as i64 * self.fixed[g as usize].unwrap_or(0)).sum::<i64>()
     }
 }
 

@@ -9,9 +9,12 @@
 //! `Z = K0⁻¹ B` (one solve per activation, cached) and `S = Bᵀ Z`, a solve
 //! `K [z; λ] = [r; c]` is `y = K0⁻¹ r`, `λ = S⁻¹ (Bᵀ y − c)`, `z = y − Z λ`.
 //! This costs one solve plus `O(n k)` per right-hand side, against one
-//! factorization, so it pays while `k` is small. All solves use the factor
-//! alone ([`LdltSolver::solve_unrefined`]): the caller refines against the
-//! true matrix.
+//! factorization, so it pays while `k` is small. When only the fixed values
+//! `c` change between solves (Algorithm 1's rounds), `r` (the right-hand side
+//! with the held fix rows zeroed) stays the same, and a `y` given by the
+//! caller ([`FixBorder::set_base`]) saves even that solve. All solves use the
+//! factor alone ([`LdltSolver::solve_unrefined`]): the caller refines against
+//! the true matrix.
 
 use super::cholesky::LdltSolver;
 use super::SolveError;
@@ -26,6 +29,8 @@ pub struct FixBorder {
     columns: Vec<Vec<f64>>,
     /// LU of `S = Bᵀ Z`, rebuilt on every activation.
     schur: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// `y = K0⁻¹ r` for the right-hand side `r` of [`Self::set_base`].
+    base: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl FixBorder {
@@ -44,15 +49,30 @@ impl FixBorder {
         self.fixes.clear();
         self.columns.clear();
         self.schur = None;
+        self.base = None;
     }
 
-    /// Activates the fix row `row` of variable `var`: one solve with `K0`.
-    pub fn push(&mut self, solver: &LdltSolver, var: usize, row: usize) -> Result<(), SolveError> {
+    /// Records `y = K0⁻¹ r` (e.g. the solution right after factorizing, when
+    /// no fix is held): later solves whose right-hand side equals `r` outside
+    /// the held fix rows reuse it instead of solving. Cleared by [`Self::clear`].
+    pub fn set_base(&mut self, r: Vec<f64>, y: Vec<f64>) {
+        self.base = Some((r, y));
+    }
+
+    /// Activates the fix rows of `fixes` (`(variable, fix row)` pairs): one
+    /// blocked solve with `K0` for all their columns.
+    pub fn push(&mut self, solver: &LdltSolver, fixes: &[(usize, usize)]) -> Result<(), SolveError> {
+        if fixes.is_empty() {
+            return Ok(());
+        }
         let n = solver.pattern().dim();
-        let mut e = vec![0.0; n];
-        e[var] = 1.0;
-        self.columns.push(solver.solve_unrefined(&e)?);
-        self.fixes.push((var, row));
+        let mut e = vec![0.0; n * fixes.len()];
+        for (j, &(var, _)) in fixes.iter().enumerate() {
+            e[j * n + var] = 1.0;
+        }
+        let z = solver.solve_unrefined_many(&e, fixes.len())?;
+        self.columns.extend(z.chunks(n).map(<[f64]>::to_vec));
+        self.fixes.extend_from_slice(fixes);
         let k = self.fixes.len();
         let s = DMatrix::from_fn(k, k, |i, j| self.columns[j][self.fixes[i].0]);
         self.schur = Some(s.lu());
@@ -69,7 +89,10 @@ impl FixBorder {
         for &(_, row) in &self.fixes {
             r[row] = 0.0;
         }
-        let mut x = solver.solve_unrefined(&r)?;
+        let mut x = match &self.base {
+            Some((base_r, y)) if *base_r == r => y.clone(),
+            _ => solver.solve_unrefined(&r)?,
+        };
         let rhs = DVector::from_iterator(self.fixes.len(), self.fixes.iter().map(|&(var, row)| x[var] - b[row]));
         let lambda = schur.solve(&rhs).ok_or(SolveError::NotFinite { what: "bordered Schur complement" })?;
         for (z, &l) in self.columns.iter().zip(lambda.iter()) {
@@ -114,8 +137,8 @@ mod tests {
         let k0 = kkt([false, false]);
         let solver = k0.solver().unwrap();
         let mut border = FixBorder::default();
-        border.push(&solver, 1, 6).unwrap();
-        border.push(&solver, 4, 7).unwrap();
+        border.push(&solver, &[(1, 6)]).unwrap();
+        border.push(&solver, &[(4, 7)]).unwrap();
         let x = border.solve(&solver, &b).unwrap();
         for (xi, ei) in x.iter().zip(&exact) {
             assert!((xi - ei).abs() < 1e-12, "{x:?} vs {exact:?}");

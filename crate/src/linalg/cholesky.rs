@@ -34,9 +34,9 @@ pub struct SolverOptions {
     pub tolerance: f64,
     /// Maximum number of refinement steps after the first solve.
     pub max_refinement_steps: usize,
-    /// A solve whose final relative residual exceeds this is reported as
-    /// [`SolveError::NotConverged`]; between `tolerance` and this it is
-    /// returned (check [`SolveInfo::relative_residual`]).
+    /// A solve whose final relative residual exceeds this (or `tolerance`,
+    /// if larger) is reported as [`SolveError::NotConverged`]; between
+    /// `tolerance` and this it is returned (check [`SolveInfo::relative_residual`]).
     pub accept_residual: f64,
 }
 
@@ -241,7 +241,7 @@ impl Core {
     }
 
     /// Solves `k` column-major right-hand sides with iterative refinement.
-    fn solve_many(&self, rhs: &[f64], k: usize) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
+    fn solve_many(&self, rhs: &[f64], k: usize, tolerance: f64) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
         if !self.factorized {
             return Err(SolveError::NotFactorized);
         }
@@ -256,7 +256,7 @@ impl Core {
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NotFinite { what: "right-hand side" });
         }
-        let opts = self.options;
+        let opts = SolverOptions { tolerance, ..self.options };
         let mut x = rhs.to_vec();
         if n == 0 || k == 0 {
             return Ok((x, vec![SolveInfo { relative_residual: 0.0, refinement_steps: 0 }; k]));
@@ -304,7 +304,7 @@ impl Core {
             }
         }
         for inf in &info {
-            if inf.relative_residual.is_nan() || inf.relative_residual > opts.accept_residual {
+            if inf.relative_residual.is_nan() || inf.relative_residual > opts.accept_residual.max(opts.tolerance) {
                 return Err(SolveError::NotConverged {
                     relative_residual: inf.relative_residual,
                     steps: inf.refinement_steps,
@@ -429,19 +429,27 @@ impl<K> SparseCholesky<K> {
     /// residual, for callers that refine against a matrix of their own.
     /// Errors if not factorized, on a bad length or on non-finite values.
     pub fn solve_unrefined(&self, rhs: &[f64]) -> Result<Vec<f64>, SolveError> {
+        self.solve_unrefined_many(rhs, 1)
+    }
+
+    /// [`Self::solve_unrefined`] for `k` right-hand sides stored column-major
+    /// in `rhs` (`n·k` values), in one blocked triangular solve.
+    pub fn solve_unrefined_many(&self, rhs: &[f64], k: usize) -> Result<Vec<f64>, SolveError> {
         let core = &self.core;
         if !core.factorized {
             return Err(SolveError::NotFactorized);
         }
         let n = core.pattern.dim();
-        if rhs.len() != n {
-            return Err(SolveError::DimensionMismatch { what: "right-hand side", expected: n, found: rhs.len() });
+        if rhs.len() != n * k {
+            return Err(SolveError::DimensionMismatch { what: "right-hand side", expected: n * k, found: rhs.len() });
         }
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NotFinite { what: "right-hand side" });
         }
         let mut x = rhs.to_vec();
-        core.raw_solve(&mut x, 1)?;
+        if n > 0 && k > 0 {
+            core.raw_solve(&mut x, k)?;
+        }
         if x.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NotFinite { what: "solution" });
         }
@@ -456,13 +464,20 @@ impl<K> SparseCholesky<K> {
 
     /// [`Self::solve`] also returning the achieved residual and step count.
     pub fn solve_with_info(&self, rhs: &[f64]) -> Result<(Vec<f64>, SolveInfo), SolveError> {
-        let (x, info) = self.core.solve_many(rhs, 1)?;
+        let (x, info) = self.core.solve_many(rhs, 1, self.core.options.tolerance)?;
         Ok((x, info[0]))
     }
 
     /// Solves for `k` right-hand sides stored column-major in `rhs`
     /// (`n·k` values) with one blocked triangular solve per refinement step.
     pub fn solve_many(&self, rhs: &[f64], k: usize) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
-        self.core.solve_many(rhs, k)
+        self.core.solve_many(rhs, k, self.core.options.tolerance)
+    }
+
+    /// [`Self::solve_many`] refined only to the relative residual
+    /// `tolerance` (at least the options' `tolerance`), for solves that need
+    /// less than the final accuracy.
+    pub fn solve_many_to(&self, rhs: &[f64], k: usize, tolerance: f64) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
+        self.core.solve_many(rhs, k, tolerance.max(self.core.options.tolerance))
     }
 }

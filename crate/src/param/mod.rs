@@ -95,6 +95,8 @@ pub struct Parametrization {
     pub flips_before_repair: usize,
     /// Flipped triangles the repair removed.
     pub flips_fixed: usize,
+    /// Fold-over repair rounds run.
+    pub repair_rounds: usize,
     /// Iterations of the injective refinement kept (0: none ran or it was not used).
     pub refine_iterations: usize,
     pub timings: ParamTimings,
@@ -206,6 +208,7 @@ pub fn parametrize(
         arap_iterations: result.arap_iterations,
         flips_before_repair: result.flips_before_repair,
         flips_fixed: result.flips_fixed,
+        repair_rounds: result.repair_rounds,
         refine_iterations: result.refine_iterations,
         timings,
     })

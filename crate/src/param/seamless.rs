@@ -27,6 +27,8 @@ pub struct SeamlessResult {
     pub arap_iterations: usize,
     pub flips_before_repair: usize,
     pub flips_fixed: usize,
+    /// Fold-over repair rounds run.
+    pub repair_rounds: usize,
     /// Iterations of the injective refinement ([`super::injective`]) kept.
     pub refine_iterations: usize,
     /// Final ARAP energy `sum_f A_f |J_f - R_f|^2`.
@@ -389,6 +391,7 @@ pub fn solve(
         arap_iterations: iterations,
         flips_before_repair: flips_before,
         flips_fixed: flips_before - best_flips,
+        repair_rounds: round,
         refine_iterations,
         energy,
     })

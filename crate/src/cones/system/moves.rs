@@ -1,0 +1,348 @@
+//! After Algorithm 1: cone-location optimization and the clean-up of close
+//! pairs (section 5.3), by transfers of cone index along the primal tree.
+//!
+//! A transfer changes only fixed `p`, i.e. right-hand-side entries of the fix
+//! rows, so its effect on the solution is `K⁻¹ Δb` whatever the current `x`
+//! is. Trials therefore cost one column of a blocked solve with the final
+//! factorization (no refactorization, no re-solve of `x`), and many trials
+//! share one blocked solve.
+
+use super::{ComponentSystem, ConeError, BORDER_BUDGET};
+use crate::mesh::NONE;
+
+/// A transfer of cone index: `(from, to, amount)` in local vertices and
+/// quarter turns.
+pub(crate) type Transfer = (usize, usize, i64);
+
+/// Relative residual of the trial solves (energy comparisons need far less
+/// than the final accuracy; the accepted state is re-solved exactly).
+const TRIAL_TOLERANCE: f64 = 1e-9;
+/// Most trial columns per blocked solve (also bounded by the memory budget).
+const MAX_TRIAL_COLUMNS: usize = 16;
+/// Relative decrease a move or cancellation must bring to be kept.
+const MIN_DECREASE: f64 = 1e-9;
+
+impl ComponentSystem<'_> {
+    /// The changes `(g, Δp_g)` of the fixed `p` that move `amount` quarter
+    /// turns of cone index from local vertex `from` to `to` along `T_p`
+    /// (leftovers are never on it).
+    fn transfer_changes(&self, (from, to, amount): Transfer) -> Vec<(usize, i64)> {
+        let (a, b) = (self.tree.vertices[from], self.tree.vertices[to]);
+        let mut x = a;
+        let mut out = Vec::new();
+        for (e, _) in self.tree.primal_path(self.mesh, a, b) {
+            let [u, w] = self.mesh.edge_vertices(e);
+            let g = self.tree.g_index[e as usize];
+            let s = self.cycles[self.local[x as usize] as usize]
+                .g
+                .iter()
+                .find(|(gg, _)| *gg == g)
+                .map(|&(_, s)| s as i64)
+                .expect("T_p edges are G edges of both end vertices");
+            out.push((g as usize, -amount * s));
+            x = if u == x { w } else { u };
+        }
+        out
+    }
+
+    /// Makes a transfer: changes the fixed `p` and the fix rows' right-hand
+    /// side (the solution `x` is left to the caller).
+    pub(crate) fn transfer(&mut self, t: Transfer) {
+        for (g, dp) in self.transfer_changes(t) {
+            let p = self.fixed[g].as_mut().expect("all p fixed before cone moves");
+            *p += dp;
+            self.constraint_rhs[self.row_fix + g] = *p as f64;
+        }
+    }
+
+    /// For each set of transfers, the change of the solution `x` that making
+    /// them all would bring (column-major, one column of `K`'s dimension per set).
+    fn responses(&mut self, sets: &[Vec<Transfer>]) -> Result<Vec<f64>, ConeError> {
+        self.settle_border()?;
+        let dim = self.kkt.pattern.dim();
+        let fix0 = self.n + self.row_fix;
+        let mut rhs = vec![0.0; dim * sets.len()];
+        for (col, set) in sets.iter().enumerate() {
+            for &t in set {
+                for (g, dp) in self.transfer_changes(t) {
+                    rhs[col * dim + fix0 + g] += dp as f64;
+                }
+            }
+        }
+        let (dx, info) = self.solver.solve_many_to(&rhs, sets.len(), TRIAL_TOLERANCE)?;
+        self.refinement_steps += info.iter().map(|i| i.refinement_steps).sum::<usize>();
+        Ok(dx)
+    }
+
+    /// Trial columns per blocked solve within the memory budget.
+    fn trial_columns(&self) -> usize {
+        MAX_TRIAL_COLUMNS.min(BORDER_BUDGET / self.kkt.pattern.dim().max(1)).max(1)
+    }
+
+    /// Makes the transfers and moves `x` by their response `dx`.
+    fn accept(&mut self, transfers: &[Transfer], dx: &[f64]) {
+        for &t in transfers {
+            self.transfer(t);
+        }
+        self.x.iter_mut().zip(dx).for_each(|(x, d)| *x += d);
+    }
+
+    /// First-order sensitivity of `phiᵀ M phi / A` to moving cone index:
+    /// returns `Phi` per local vertex such that moving `a` quarter turns from
+    /// `u` to `w` (along `T_p`, as [`Self::transfer`] does) changes the
+    /// energy by about `2 a (Phi[w] - Phi[u])`. One solve with the current
+    /// factorization: `y = K⁻¹ [D phi; 0]`, read on the fix rows.
+    fn move_potential(&mut self) -> Result<Vec<f64>, ConeError> {
+        self.settle_border()?;
+        let nv = self.tree.vertices.len();
+        let mut r = vec![0.0; self.n + self.constraint_rhs.len()];
+        for i in 0..nv {
+            r[i] = self.area[i] / self.total_area * self.x[i];
+        }
+        // A ranking needs no more than the trials' accuracy.
+        let y = self.solver.solve_many_to(&r, 1, TRIAL_TOLERANCE)?.0;
+        let mut order: Vec<usize> = (0..nv).collect();
+        order.sort_by_key(|&i| self.tree.primal_depth[self.tree.vertices[i] as usize]);
+        let mut phi = vec![0.0; nv];
+        for i in order {
+            let h = self.tree.primal_parent_he[self.tree.vertices[i] as usize];
+            if h == NONE {
+                continue; // the root of T_p
+            }
+            let parent = self.local[self.mesh.tail(h) as usize] as usize;
+            let g = self.tree.g_index[self.mesh.edge(h) as usize];
+            let sigma = self.cycles[i].g.iter().find(|(gg, _)| *gg == g).map_or(0, |&(_, s)| s);
+            phi[i] = phi[parent] + y[self.n + self.row_fix + g as usize] * sigma as f64;
+        }
+        Ok(phi)
+    }
+
+    /// Cone-location optimization (section 5.3): moves an interior cone to
+    /// a neighbouring interior vertex when that lowers `phiᵀ M phi / A`,
+    /// until no move helps or `max_passes` passes. Candidates are ranked by
+    /// the first-order change ([`Self::move_potential`]) and the two most
+    /// promising per cone are evaluated exactly; after the first pass only
+    /// cones within two rings of a moved cone are reconsidered. Returns the
+    /// moves made.
+    pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
+        const EXACT_TRIES: usize = 2;
+        let mut moves = 0;
+        let mut current = self.phi_norm2();
+        let nv = self.tree.vertices.len();
+        // Cones to (re)consider: all at first, then those near a moved cone.
+        let mut dirty = vec![true; nv];
+        for pass in 0..max_passes {
+            progress(pass);
+            let potential = self.move_potential()?;
+            // Per dirty interior cone: its index and its best candidates.
+            let mut plans: Vec<(usize, i64, Vec<usize>)> = Vec::new();
+            for i in 0..nv {
+                let ki = self.vertex_k_at(i);
+                let v = self.tree.vertices[i];
+                if ki == 0 || !dirty[i] || self.mesh.is_boundary_vertex(v) {
+                    continue;
+                }
+                let mut candidates: Vec<(f64, usize)> = self
+                    .mesh
+                    .one_ring(v)
+                    .filter(|&w| !self.mesh.is_boundary_vertex(w))
+                    .map(|w| self.local[w as usize] as usize)
+                    .map(|j| (2.0 * ki as f64 * (potential[j] - potential[i]), j))
+                    .filter(|&(estimate, _)| estimate < -MIN_DECREASE * current)
+                    .collect();
+                candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+                candidates.truncate(EXACT_TRIES);
+                if !candidates.is_empty() {
+                    plans.push((i, ki, candidates.into_iter().map(|c| c.1).collect()));
+                }
+            }
+            dirty.iter_mut().for_each(|d| *d = false);
+            let mut moved = 0;
+            let per_solve = (self.trial_columns() / EXACT_TRIES).max(1);
+            for chunk in plans.chunks(per_solve) {
+                let sets: Vec<Vec<Transfer>> =
+                    chunk.iter().flat_map(|(i, ki, js)| js.iter().map(move |&j| vec![(*i, j, *ki)])).collect();
+                let dx = self.responses(&sets)?;
+                let dim = self.kkt.pattern.dim();
+                let mut first = 0;
+                for (i, ki, js) in chunk {
+                    let (i, start) = (*i, first);
+                    first += js.len();
+                    // An earlier move of this pass may have changed this cone.
+                    let k_now = self.vertex_k_at(i);
+                    if k_now == 0 {
+                        continue;
+                    }
+                    let own;
+                    let (source, start) = if k_now == *ki {
+                        (&dx, start)
+                    } else {
+                        own = self.responses(&js.iter().map(|&j| vec![(i, j, k_now)]).collect::<Vec<_>>())?;
+                        (&own, 0)
+                    };
+                    let column = |c: usize| &source[(start + c) * dim..(start + c + 1) * dim];
+                    let mut best: Option<(f64, usize)> = None;
+                    for c in 0..js.len() {
+                        let e = self.phi_norm2_at(&self.x, Some(column(c)));
+                        if e < current * (1.0 - MIN_DECREASE) && best.map_or(true, |b| e < b.0) {
+                            best = Some((e, c));
+                        }
+                    }
+                    if let Some((e, c)) = best {
+                        let j = js[c];
+                        let d = column(c).to_vec();
+                        self.accept(&[(i, j, k_now)], &d);
+                        current = e;
+                        moves += 1;
+                        moved += 1;
+                        let w = self.tree.vertices[j];
+                        dirty[j] = true;
+                        for a in self.mesh.one_ring(w) {
+                            dirty[self.local[a as usize] as usize] = true;
+                            for b in self.mesh.one_ring(a) {
+                                dirty[self.local[b as usize] as usize] = true;
+                            }
+                        }
+                    }
+                }
+            }
+            if moved == 0 {
+                break;
+            }
+        }
+        self.solve()?;
+        Ok(moves)
+    }
+
+    /// Unit transfers that cancel every interior cone: each quarter turn of a
+    /// positive cone goes to the nearest negative cone with index left.
+    fn pairing(&self, cones: &[(usize, i64)]) -> Vec<Transfer> {
+        let pos = |i: usize| self.mesh.position(self.tree.vertices[i]);
+        let mut left: Vec<(usize, i64)> = cones.iter().filter(|c| c.1 < 0).copied().collect();
+        let mut moves = Vec::new();
+        for &(i, ki) in cones.iter().filter(|c| c.1 > 0) {
+            for _ in 0..ki {
+                let Some(best) = (0..left.len()).filter(|&n| left[n].1 < 0).min_by(|&a, &b| {
+                    let d = |n: usize| crate::vec3::norm(crate::vec3::sub(pos(i), pos(left[n].0)));
+                    d(a).total_cmp(&d(b))
+                }) else {
+                    break;
+                };
+                moves.push((i, left[best].0, 1));
+                left[best].1 += 1;
+            }
+        }
+        moves
+    }
+
+    /// Interior cones as (local vertex, k).
+    fn interior_cones(&self) -> Vec<(usize, i64)> {
+        (0..self.cycles.len())
+            .map(|i| (i, self.vertex_k_at(i)))
+            .filter(|&(i, k)| k != 0 && !self.mesh.is_boundary_vertex(self.tree.vertices[i]))
+            .collect()
+    }
+
+    /// Clean-up of section 5.3 (after Myles & Zorin 2012): cancels pairs of
+    /// interior cones of opposite index one or two edges apart, unless that
+    /// raises the objective by more than [`super::MERGE_TOLERANCE`] (on coarse
+    /// meshes a close pair can carry a real rotation). Returns the pairs removed.
+    pub fn merge_close_pairs(&mut self) -> Result<usize, ConeError> {
+        let mut merged = 0;
+        let mut rejected: std::collections::HashSet<(usize, usize)> = Default::default();
+        let mut current = self.objective();
+        loop {
+            let cones = self.interior_cones();
+            let index: std::collections::HashMap<usize, i64> = cones.iter().copied().collect();
+            let mut pair = None;
+            'search: for &(i, ki) in &cones {
+                let v = self.tree.vertices[i];
+                for w in self.mesh.one_ring(v) {
+                    for x in std::iter::once(w).chain(self.mesh.one_ring(w)) {
+                        let j = self.local[x as usize] as usize;
+                        if j != i && index.get(&j) == Some(&-ki) && !rejected.contains(&(i, j)) {
+                            pair = Some((i, j, ki));
+                            break 'search;
+                        }
+                    }
+                }
+            }
+            let Some(t) = pair else { break };
+            let dx = self.responses(&[vec![t]])?;
+            let e = self.objective_at(&self.x, Some(&dx));
+            if e <= current * (1.0 + super::MERGE_TOLERANCE) {
+                self.accept(&[t], &dx);
+                current = e;
+                merged += 1;
+            } else {
+                rejected.insert((t.0, t.1));
+                rejected.insert((t.1, t.0));
+            }
+        }
+        self.solve()?;
+        Ok(merged)
+    }
+
+    /// Pair cancellation by descent on the objective (an extension of the
+    /// paper's clean-up to distant pairs): for each interior cone, tries
+    /// cancelling it against each of its `nearest` closest cones of opposite
+    /// index and keeps the best cancellation while the objective decreases.
+    /// Returns the number of pairs removed.
+    pub fn cancel_pairs(&mut self, nearest: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
+        let mut removed = 0;
+        let mut current = self.objective();
+        // Global candidate: when the interior indices sum to zero, all cones
+        // may cancel at once (a single pair's removal can cost energy while
+        // removing all of them lowers it, e.g. on a torus of revolution).
+        let cones = self.interior_cones();
+        if !cones.is_empty() && cones.iter().map(|c| c.1).sum::<i64>() == 0 {
+            let moves = self.pairing(&cones);
+            let dx = self.responses(&[moves.clone()])?;
+            let e = self.objective_at(&self.x, Some(&dx));
+            if e < current * (1.0 - MIN_DECREASE) {
+                self.accept(&moves, &dx);
+                current = e;
+                removed += moves.len();
+            }
+        }
+        loop {
+            progress(removed);
+            let cones = self.interior_cones();
+            let pos = |i: usize| self.mesh.position(self.tree.vertices[i]);
+            // Each pair is tried once, from its positive cone.
+            let mut trials: Vec<Transfer> = Vec::new();
+            for &(i, ki) in cones.iter().filter(|c| c.1 > 0) {
+                let mut partners: Vec<(f64, usize)> = cones
+                    .iter()
+                    .filter(|&&(j, kj)| kj == -ki && j != i)
+                    .map(|&(j, _)| (crate::vec3::norm(crate::vec3::sub(pos(i), pos(j))), j))
+                    .collect();
+                partners.sort_by(|a, b| a.0.total_cmp(&b.0));
+                trials.extend(partners.iter().take(nearest).map(|&(_, j)| (i, j, ki)));
+            }
+            let mut best: Option<(f64, Transfer, Vec<f64>)> = None;
+            let dim = self.kkt.pattern.dim();
+            for chunk in trials.chunks(self.trial_columns()) {
+                let sets: Vec<Vec<Transfer>> = chunk.iter().map(|&t| vec![t]).collect();
+                let dx = self.responses(&sets)?;
+                for (c, &t) in chunk.iter().enumerate() {
+                    let d = &dx[c * dim..(c + 1) * dim];
+                    let e = self.objective_at(&self.x, Some(d));
+                    if e < current * (1.0 - MIN_DECREASE) && best.as_ref().map_or(true, |b| e < b.0) {
+                        best = Some((e, t, d.to_vec()));
+                    }
+                }
+            }
+            match best {
+                Some((e, t, d)) => {
+                    self.accept(&[t], &d);
+                    current = e;
+                    removed += 1;
+                }
+                None => break,
+            }
+        }
+        self.solve()?;
+        Ok(removed)
+    }
+}
