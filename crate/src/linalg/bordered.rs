@@ -145,4 +145,27 @@ mod tests {
         }
         assert!((x[1] - 0.7).abs() < 1e-12 && (x[4] + 0.3).abs() < 1e-12, "fixed values hold");
     }
+
+    #[test]
+    fn a_recorded_base_solution_is_reused_only_for_its_right_hand_side() {
+        let k0 = kkt([false, false]);
+        let solver = k0.solver().unwrap();
+        // Base: the right-hand side with both (inactive) fix rows at 0.
+        let r = [1.0, -2.0, 0.5, 3.0, -1.0, 0.25, 0.0, 0.0];
+        let y = solver.solve(&r).unwrap();
+        let mut border = FixBorder::default();
+        border.set_base(r.to_vec(), y);
+        border.push(&solver, &[(1, 6), (4, 7)]).unwrap();
+        // Same outside the held fix rows: the base is used; the result must
+        // still be the exact bordered solution.
+        let b = [1.0, -2.0, 0.5, 3.0, -1.0, 0.25, 0.7, -0.3];
+        let exact = kkt([true, true]).solver().unwrap().solve(&b).unwrap();
+        let x = border.solve(&solver, &b).unwrap();
+        assert!(x.iter().zip(&exact).all(|(a, e)| (a - e).abs() < 1e-12), "{x:?} vs {exact:?}");
+        // A different right-hand side elsewhere must not reuse it.
+        let b2 = [0.0, 1.0, 0.5, 3.0, -1.0, 0.25, 0.7, -0.3];
+        let exact2 = kkt([true, true]).solver().unwrap().solve(&b2).unwrap();
+        let x2 = border.solve(&solver, &b2).unwrap();
+        assert!(x2.iter().zip(&exact2).all(|(a, e)| (a - e).abs() < 1e-12), "{x2:?} vs {exact2:?}");
+    }
 }

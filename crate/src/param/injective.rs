@@ -27,6 +27,9 @@ use crate::linalg::{Kkt, LdltSolver, SolverOptions, Triplet};
 /// next one gains much, so single iterations are a poor test.
 pub const STALL_WINDOW: usize = 5;
 
+/// Iterations per factorization of the proxy matrix (see [`Refiner::refine`]).
+const REFACTOR_EVERY: usize = 3;
+
 /// Relative residual the global step's solve is refined to.
 const STEP_TOLERANCE: f64 = 1e-8;
 
@@ -253,7 +256,13 @@ impl<'a> Refiner<'a> {
         let nf = self.elements.len();
         let mut trial = x.to_vec();
         let mut history = vec![e];
+        let mut stale_failed = true;
         for iteration in 0..options.max_iterations {
+            // The proxy matrix changes slowly: steps in between refactorizations
+            // reuse the last factor (still a descent direction, as the matrix is
+            // positive definite on the constraints' null space); a stale step
+            // that brings no decrease is retried with a fresh factorization.
+            let refresh = stale_failed || iteration % REFACTOR_EVERY == 0;
             progress(iteration);
             if e <= 0.0 {
                 break;
@@ -292,7 +301,13 @@ impl<'a> Refiner<'a> {
             debug_assert_eq!(self.values.len(), 36 * nf + self.constraints.len());
             // Global step: the step d (C d = 0) minimising the proxy. A
             // numerical failure ends the refinement at the current iterate.
-            let Some(d) = self.step(&rhs) else { break };
+            let Some(d) = self.step(&rhs, refresh) else {
+                if refresh {
+                    break;
+                }
+                stale_failed = true;
+                continue;
+            };
             // Line search: largest flip-free step, halved until E decreases.
             let mut t = 1.0f64;
             for el in self.elements {
@@ -315,7 +330,14 @@ impl<'a> Refiner<'a> {
                 }
                 t *= 0.5;
             }
-            let Some(et) = accepted else { break };
+            let Some(et) = accepted else {
+                if refresh {
+                    break;
+                }
+                stale_failed = true;
+                continue;
+            };
+            stale_failed = false;
             x.copy_from_slice(&trial);
             stats.iterations += 1;
             e = et;
@@ -331,11 +353,14 @@ impl<'a> Refiner<'a> {
         stats
     }
 
-    /// Refactors with the current values and solves for the step `d` (primal
-    /// part, pushed onto `C d = 0`); `None` on any numerical failure.
-    fn step(&mut self, rhs: &[f64]) -> Option<Vec<f64>> {
-        self.kkt.pattern.fill_values_with_slots(&self.slots, &self.values, &mut self.kkt.values).ok()?;
-        self.solver.factorize(&self.kkt.values).ok()?;
+    /// Solves for the step `d` (primal part, pushed onto `C d = 0`), after
+    /// refactorizing with the current values if `refresh`; `None` on any
+    /// numerical failure.
+    fn step(&mut self, rhs: &[f64], refresh: bool) -> Option<Vec<f64>> {
+        if refresh {
+            self.kkt.pattern.fill_values_with_slots(&self.slots, &self.values, &mut self.kkt.values).ok()?;
+            self.solver.factorize(&self.kkt.values).ok()?;
+        }
         // A descent direction needs no more (make_feasible restores C d = 0).
         let sol = self.solver.solve_many_to(rhs, 1, STEP_TOLERANCE).ok()?.0;
         let mut d = sol[..self.n].to_vec();
