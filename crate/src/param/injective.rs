@@ -28,7 +28,7 @@ use crate::linalg::{Kkt, LdltSolver, SolverOptions, Triplet};
 pub const STALL_WINDOW: usize = 5;
 
 /// Iterations per factorization of the proxy matrix (see [`Refiner::refine`]).
-const REFACTOR_EVERY: usize = 3;
+const REFACTOR_EVERY: usize = 5;
 
 /// Relative residual the global step's solve is refined to.
 const STEP_TOLERANCE: f64 = 1e-8;
