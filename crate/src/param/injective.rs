@@ -231,6 +231,9 @@ impl<'a> Refiner<'a> {
         t.extend(constraints.iter().map(|&(r, c, v)| (c, n + r, v)));
         let slots = kkt.pattern.slot_map(&t)?;
         let values = t.iter().map(|e| e.2).collect();
+        // The triplets (36 per face) are the largest temporary: free them
+        // before the factor is allocated (wasm memory never shrinks).
+        drop(t);
         let solver = LdltSolver::with_options(
             &kkt.pattern,
             &kkt.signs,
