@@ -96,8 +96,8 @@ impl ComponentSystem<'_> {
         self.settle_border()?;
         let nv = self.tree.vertices.len();
         let mut r = vec![0.0; self.n + self.constraint_rhs.len()];
-        for i in 0..nv {
-            r[i] = self.area[i] / self.total_area * self.x[i];
+        for ((ri, a), x) in r.iter_mut().zip(&self.area).zip(&self.x) {
+            *ri = a / self.total_area * x;
         }
         // A ranking needs no more than the trials' accuracy.
         let y = self.solver.solve_many_to(&r, 1, TRIAL_TOLERANCE)?.0;
@@ -184,7 +184,7 @@ impl ComponentSystem<'_> {
                     let mut best: Option<(f64, usize)> = None;
                     for c in 0..js.len() {
                         let e = self.phi_norm2_at(&self.x, Some(column(c)));
-                        if e < current * (1.0 - MIN_DECREASE) && best.map_or(true, |b| e < b.0) {
+                        if e < current * (1.0 - MIN_DECREASE) && best.is_none_or(|b| e < b.0) {
                             best = Some((e, c));
                         }
                     }
@@ -297,7 +297,7 @@ impl ComponentSystem<'_> {
         let cones = self.interior_cones();
         if !cones.is_empty() && cones.iter().map(|c| c.1).sum::<i64>() == 0 {
             let moves = self.pairing(&cones);
-            let dx = self.responses(&[moves.clone()])?;
+            let dx = self.responses(std::slice::from_ref(&moves))?;
             let e = self.objective_at(&self.x, Some(&dx));
             if e < current * (1.0 - MIN_DECREASE) {
                 self.accept(&moves, &dx);
@@ -328,7 +328,7 @@ impl ComponentSystem<'_> {
                 for (c, &t) in chunk.iter().enumerate() {
                     let d = &dx[c * dim..(c + 1) * dim];
                     let e = self.objective_at(&self.x, Some(d));
-                    if e < current * (1.0 - MIN_DECREASE) && best.as_ref().map_or(true, |b| e < b.0) {
+                    if e < current * (1.0 - MIN_DECREASE) && best.as_ref().is_none_or(|b| e < b.0) {
                         best = Some((e, t, d.to_vec()));
                     }
                 }
