@@ -24,7 +24,7 @@ mod pattern;
 mod tests;
 
 pub use bordered::FixBorder;
-pub use cholesky::{Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
+pub use cholesky::{Fronts, Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
 pub use kkt::{solve_kkt, Kkt, KktSolution};
 pub use pattern::{SymmetricPattern, Triplet, IGNORED_SLOT};
 

@@ -20,7 +20,7 @@
 
 use super::seamless::Element;
 use super::ParamError;
-use crate::linalg::{Kkt, LdltSolver, SolverOptions, Triplet};
+use crate::linalg::{Fronts, Kkt, LdltSolver, SolverOptions, Triplet};
 
 /// Iterations over which the energy decrease is averaged for the stop test:
 /// a step limited by one nearly degenerate triangle can gain little while the
@@ -234,11 +234,8 @@ impl<'a> Refiner<'a> {
         // The triplets (36 per face) are the largest temporary: free them
         // before the factor is allocated (wasm memory never shrinks).
         drop(t);
-        let solver = LdltSolver::with_options(
-            &kkt.pattern,
-            &kkt.signs,
-            SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-6, ..SolverOptions::default() },
-        )?;
+        let mut solver = LdltSolver::with_fronts(&kkt.pattern, &kkt.signs, Fronts::Dense)?;
+        solver.set_options(SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-6, ..SolverOptions::default() });
         Ok(Refiner { elements, n, constraints, kkt, solver, slots, values })
     }
 
