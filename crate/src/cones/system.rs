@@ -38,11 +38,14 @@ const ROUNDING_BATCH: f64 = 0.5;
 const ROUNDING_TOLERANCE: f64 = 1e-6;
 /// Memory budget (in f64s) for the cached columns of the bordered updates.
 const BORDER_BUDGET: usize = 8 << 20;
-/// Most fixes handled by bordered updates before the KKT is refactorized.
-const MAX_BORDER: usize = 48;
-/// A round fixing more than this refactorizes instead of bordering: one
-/// bordered column costs a tenth to a twentieth of a factorization and solve.
-const MAX_BORDER_BATCH: usize = 16;
+/// Most fixes handled by bordered updates before the KKT is refactorized,
+/// and most fixes of one round bordered rather than refactorized. Natively,
+/// faer's SIMD dense kernels make a factorization cost only 10-20 bordered
+/// columns; in wasm (simplicial, scalar) bordering pays much longer.
+/// Measured on the fandisk subdivided to 207 k faces (rounding 20.6 s
+/// natively, 40.7 s in wasm; the other target's values cost 4-5 s).
+const MAX_BORDER: usize = if cfg!(target_arch = "wasm32") { 96 } else { 48 };
+const MAX_BORDER_BATCH: usize = if cfg!(target_arch = "wasm32") { MAX_BORDER } else { 16 };
 /// Largest relative LDLᵀ regularization tried before a solve failure is reported.
 const MAX_DELTA: f64 = 1e-4;
 
