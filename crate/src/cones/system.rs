@@ -45,6 +45,7 @@ const BORDER_BUDGET: usize = 8 << 20;
 /// Measured on the fandisk subdivided to 207 k faces (rounding 20.6 s
 /// natively, 40.7 s in wasm; the other target's values cost 4-5 s).
 const MAX_BORDER: usize = if cfg!(target_arch = "wasm32") { 96 } else { 48 };
+/// A round fixing more than this refactorizes (see [`MAX_BORDER`]).
 const MAX_BORDER_BATCH: usize = if cfg!(target_arch = "wasm32") { MAX_BORDER } else { 16 };
 /// Largest relative LDLᵀ regularization tried before a solve failure is reported.
 const MAX_DELTA: f64 = 1e-4;
