@@ -30,6 +30,9 @@ pub const STALL_WINDOW: usize = 5;
 /// Iterations per factorization of the proxy matrix (see [`Refiner::refine`]).
 const REFACTOR_EVERY: usize = 5;
 
+/// Most correction solves that push a step back onto the constraints.
+const FEASIBILITY_CORRECTIONS: usize = 6;
+
 /// Relative residual the global step's solve is refined to.
 const STEP_TOLERANCE: f64 = 1e-8;
 
@@ -376,19 +379,21 @@ impl<'a> Refiner<'a> {
         res
     }
 
-    /// Pushes the step `d` back onto `C d = 0` (one correction solve with the
-    /// current factor when the solve left `|C d| > 1e-14 |d|`); false when
-    /// that fails, so the step must be discarded.
+    /// Pushes the step `d` back onto `C d = 0` (correction solves with the
+    /// current factor while the solve left `|C d| > 1e-14 |d|`, at most
+    /// [`FEASIBILITY_CORRECTIONS`]); false when that fails, so the step must
+    /// be discarded.
     fn make_feasible(&self, d: &mut [f64]) -> bool {
         let size = max_abs(d).max(f64::MIN_POSITIVE);
-        for _ in 0..2 {
+        for _ in 0..FEASIBILITY_CORRECTIONS {
             let res = self.constraint_rows(d);
             if max_abs(&res) <= 1e-14 * size {
                 return true;
             }
             let mut rhs = vec![0.0; self.n];
             rhs.extend(res.iter().map(|v| -v));
-            // The correction is tiny: the factor alone makes it exact enough.
+            // Each correction is a plain factor solve: they act as the
+            // refinement steps of this small right-hand side.
             let Ok(corr) = self.solver.solve_unrefined(&rhs) else { return false };
             for (di, ci) in d.iter_mut().zip(&corr) {
                 *di += ci;
