@@ -279,12 +279,15 @@ impl<'a> Refiner<'a> {
                     proxy_ok = false;
                     break;
                 };
-                let base = 36 * f;
-                let mut s = 0;
-                for_pairs_full(|c, k, c2, k2| {
-                    self.values[base + s] = el.area * mm[c][c2] * (el.g[k][0] * el.g[k2][0] + el.g[k][1] * el.g[k2][1]);
-                    s += 1;
-                });
+                if refresh {
+                    // The matrix values: only a refactorization reads them.
+                    let base = 36 * f;
+                    let mut s = 0;
+                    for_pairs_full(|c, k, c2, k2| {
+                        self.values[base + s] = el.area * mm[c][c2] * (el.g[k][0] * el.g[k2][0] + el.g[k][1] * el.g[k2][1]);
+                        s += 1;
+                    });
+                }
                 // r = M (R - J), per frame direction d; rhs_(c,k) += A sum_d g_k[d] r[c][d].
                 let mut r = [[0.0; 2]; 2];
                 for c in 0..2 {

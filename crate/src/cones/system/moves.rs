@@ -23,6 +23,12 @@ const MAX_TRIAL_COLUMNS: usize = 16;
 const MIN_DECREASE: f64 = 1e-9;
 
 impl ComponentSystem<'_> {
+    /// `sigma_ig`: the sign with which local vertex `i`'s cycle crosses `G`
+    /// edge `g` (`None` if it does not).
+    fn sigma(&self, i: usize, g: u32) -> Option<i32> {
+        self.cycles[i].g.iter().find(|(gg, _)| *gg == g).map(|&(_, s)| s)
+    }
+
     /// The changes `(g, Δp_g)` of the fixed `p` that move `amount` quarter
     /// turns of cone index from local vertex `from` to `to` along `T_p`
     /// (leftovers are never on it).
@@ -33,12 +39,7 @@ impl ComponentSystem<'_> {
         for (e, _) in self.tree.primal_path(self.mesh, a, b) {
             let [u, w] = self.mesh.edge_vertices(e);
             let g = self.tree.g_index[e as usize];
-            let s = self.cycles[self.local[x as usize] as usize]
-                .g
-                .iter()
-                .find(|(gg, _)| *gg == g)
-                .map(|&(_, s)| s as i64)
-                .expect("T_p edges are G edges of both end vertices");
+            let s = self.sigma(self.local[x as usize] as usize, g).expect("T_p edges are G edges of both end vertices") as i64;
             out.push((g as usize, -amount * s));
             x = if u == x { w } else { u };
         }
@@ -111,7 +112,7 @@ impl ComponentSystem<'_> {
             }
             let parent = self.local[self.mesh.tail(h) as usize] as usize;
             let g = self.tree.g_index[self.mesh.edge(h) as usize];
-            let sigma = self.cycles[i].g.iter().find(|(gg, _)| *gg == g).map_or(0, |&(_, s)| s);
+            let sigma = self.sigma(i, g).unwrap_or(0);
             phi[i] = phi[parent] + y[self.n + self.row_fix + g as usize] * sigma as f64;
         }
         Ok(phi)
