@@ -4,7 +4,7 @@
 //! parametrization (Appendix B). The CLI and the wasm API call this.
 
 use crate::clock::Stopwatch;
-use crate::cones::{self, ConeError, ConeOptions, ConePlacement};
+use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
 use crate::features::{split_around, split_doubly_constrained, FeatureSet, Refined};
 use crate::mesh::TriMesh;
 use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrization};
@@ -29,6 +29,8 @@ pub enum SolveProgress {
 #[derive(Clone, Debug, PartialEq)]
 pub enum SolveError {
     Cones(ConeError),
+    /// Component placements from elsewhere that do not fit the stage.
+    Components(MismatchError),
     Param(ParamError),
 }
 
@@ -36,6 +38,7 @@ impl fmt::Display for SolveError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             SolveError::Cones(e) => write!(f, "{e}"),
+            SolveError::Components(e) => write!(f, "{e}"),
             SolveError::Param(e) => write!(f, "parametrization: {e}"),
         }
     }
@@ -112,33 +115,114 @@ pub fn solve<'a>(
     options: &SolveOptions,
     progress: &mut dyn FnMut(SolveProgress),
 ) -> Result<Solution<'a>, SolveError> {
-    let mut clock = Stopwatch::start();
-    let mut refined = split_doubly_constrained(mesh, features);
-    let mut refine_seconds = clock.lap();
-    let mut attempt = 0;
-    let placement = loop {
+    let mut stage = ConeStage::new(mesh, features, options);
+    let placed = loop {
+        let results = cones::place_all(stage.problem(), &mut |p| progress(SolveProgress::Cones(p))).map_err(SolveError::Cones)?;
+        match stage.finish(mesh, features, results)? {
+            ConeStep::Placed(placed) => break placed,
+            ConeStep::Again(next) => stage = next,
+        }
+    };
+    placed.parametrize(mesh, features, &mut |p| progress(SolveProgress::Param(p)))
+}
+
+/// The cone stage of [`solve`] as steps, so that its components can be
+/// placed anywhere (threads, other wasm instances that built the same
+/// stage): build it, place every component of [`ConeStage::problem`], then
+/// [`ConeStage::finish`]. Every method takes the same `mesh` and `features`.
+#[derive(Clone, Debug)]
+pub struct ConeStage {
+    options: SolveOptions,
+    /// The refinement of the input solved on (`None`: the input itself).
+    refined: Option<Refined>,
+    /// Refinements around cones of angle 0 made so far.
+    attempt: usize,
+    refine_seconds: f64,
+    problem: ConeProblem,
+}
+
+/// What [`ConeStage::finish`] leads to.
+#[derive(Clone, Debug)]
+pub enum ConeStep {
+    /// The cones are placed: go on to the parametrization.
+    Placed(Placed),
+    /// Cones of angle 0 appeared: the mesh was refined around them; place
+    /// the new stage's components again.
+    Again(ConeStage),
+}
+
+/// A finished cone stage, ready for [`Placed::parametrize`].
+#[derive(Clone, Debug)]
+pub struct Placed {
+    options: SolveOptions,
+    refined: Option<Refined>,
+    refine_seconds: f64,
+    pub placement: ConePlacement,
+}
+
+impl ConeStage {
+    /// Splits doubly constrained triangles and prepares the cone problem.
+    pub fn new(mesh: &TriMesh, features: &FeatureSet, options: &SolveOptions) -> ConeStage {
+        let mut clock = Stopwatch::start();
+        let refined = split_doubly_constrained(mesh, features);
+        let refine_seconds = clock.lap();
+        ConeStage::with_refinement(mesh, features, options, refined, 0, refine_seconds)
+    }
+
+    fn with_refinement(
+        mesh: &TriMesh,
+        features: &FeatureSet,
+        options: &SolveOptions,
+        refined: Option<Refined>,
+        attempt: usize,
+        refine_seconds: f64,
+    ) -> ConeStage {
         let (m, f) = refined.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
-        let placement = cones::place_cones(m, f, &options.cones, &mut |p| progress(SolveProgress::Cones(p)))
-            .map_err(SolveError::Cones)?;
+        let problem = ConeProblem::new(m, f, &options.cones);
+        ConeStage { options: *options, refined, attempt, refine_seconds, problem }
+    }
+
+    /// The components to place.
+    pub fn problem(&self) -> &ConeProblem {
+        &self.problem
+    }
+
+    /// Joins the placed components (one per component of
+    /// [`Self::problem`]); refines around cones of angle 0 while attempts remain.
+    pub fn finish(self, mesh: &TriMesh, features: &FeatureSet, results: Vec<ComponentPlacement>) -> Result<ConeStep, SolveError> {
+        let ConeStage { options, refined, attempt, mut refine_seconds, problem } = self;
+        let m = refined.as_ref().map_or(mesh, |r| &r.mesh);
+        let placement = problem.assemble(m, results).map_err(SolveError::Components)?;
         let degenerate = zero_angle_cones(&placement);
         if degenerate.is_empty() || attempt == MAX_CONE_REFINEMENTS {
-            break placement;
+            return Ok(ConeStep::Placed(Placed { options, refined, refine_seconds, placement }));
         }
         // Only vertices of `m` are named; lift the refinement one level.
-        clock.lap();
-        refined = Some(split_around(mesh, features, refined.take(), &degenerate));
+        let mut clock = Stopwatch::start();
+        let refined = Some(split_around(mesh, features, refined, &degenerate));
         refine_seconds += clock.lap();
-        attempt += 1;
-    };
-    let (mesh, features, splits, original_face, original_vertex) = match refined {
-        Some(Refined { mesh: m, features: f, splits, original_face, original_vertex }) => {
-            (Cow::Owned(m), Cow::Owned(f), splits, Some(original_face), Some(original_vertex))
-        }
-        None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None),
-    };
-    let param = param::parametrize(&mesh, &placement, &options.param, &mut |p| progress(SolveProgress::Param(p)))
-        .map_err(SolveError::Param)?;
-    Ok(Solution { mesh, features, splits, original_face, original_vertex, placement, param, refine_seconds })
+        Ok(ConeStep::Again(ConeStage::with_refinement(mesh, features, &options, refined, attempt + 1, refine_seconds)))
+    }
+}
+
+impl Placed {
+    /// The seamless aligned parametrization (Appendix B) on the placed cones.
+    pub fn parametrize<'a>(
+        self,
+        mesh: &'a TriMesh,
+        features: &'a FeatureSet,
+        progress: &mut dyn FnMut(ParamProgress),
+    ) -> Result<Solution<'a>, SolveError> {
+        let Placed { options, refined, refine_seconds, placement } = self;
+        let (mesh, features, splits, original_face, original_vertex) = match refined {
+            Some(Refined { mesh: m, features: f, splits, original_face, original_vertex }) => {
+                (Cow::Owned(m), Cow::Owned(f), splits, Some(original_face), Some(original_vertex))
+            }
+            None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None),
+        };
+        let param = param::parametrize(&mesh, &placement, &options.param, progress).map_err(SolveError::Param)?;
+        Ok(Solution { mesh, features, splits, original_face, original_vertex, placement, param, refine_seconds })
+    }
 }
 
 /// Rounds of local refinement tried when cones of angle 0 appear.

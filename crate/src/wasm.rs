@@ -2,10 +2,10 @@
 //!
 //! Errors cross as JS `Error`s carrying the library's one-line message.
 
-use crate::cones::{self, ConeOptions, ConePlacement, Progress};
+use crate::cones::{self, ComponentPlacement, ConeOptions, ConePlacement, Progress};
 use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::{self, ParamOptions, ParamProgress};
-use crate::pipeline::{self, SolveOptions, SolveProgress};
+use crate::pipeline::{ConeStage, ConeStep, Solution, SolveError, SolveOptions};
 use crate::features::FeatureSet;
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -47,6 +47,15 @@ pub struct MeshSession {
     positions: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     mesh: Option<TriMesh>,
+    /// The solve in progress through the `solve_*` steps.
+    job: Option<Job>,
+}
+
+/// A solve run in steps: its features, its cone stage and the components placed so far.
+struct Job {
+    features: FeatureSet,
+    stage: ConeStage,
+    placed: Vec<ComponentPlacement>,
 }
 
 #[wasm_bindgen]
@@ -66,7 +75,7 @@ impl MeshSession {
                 (w.positions, w.triangles)
             }
         };
-        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh })
+        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None })
     }
 
     /// The mesh report (`MeshReport` plus `problem_messages`, one line each).
@@ -135,11 +144,7 @@ impl MeshSession {
         progress: &Function,
     ) -> Result<JsValue, JsError> {
         let (mesh, features, options) = self.request(feature_edges, alpha_smooth, miq)?;
-        let mut report = |p: Progress| {
-            let (stage, a, b) = cone_stage(&p);
-            notify(progress, stage, a, b);
-        };
-        let r = cones::place_cones(mesh, &features, &options, &mut report).map_err(|e| JsError::new(&e.to_string()))?;
+        let r = cones::place_cones(mesh, &features, &options, &mut cone_progress(progress)).map_err(|e| JsError::new(&e.to_string()))?;
         Ok(cone_result(&r, features.len())?.into())
     }
 }
@@ -151,30 +156,84 @@ impl MeshSession {
     /// face corner `3 f + k`), `seam_edges` (input edge ids), `metrics`
     /// (with `per_face_distortion`), `timings`, `inserted_vertices` (by the refinement), `glb`
     /// (Uint8Array) and `obj` (string) of the solved mesh.
-    pub fn solve(
-        &self,
-        feature_edges: &[u32],
-        alpha_smooth: f64,
-        miq: bool,
-        progress: &Function,
-    ) -> Result<JsValue, JsError> {
-        let (mesh, features, cone_options) = self.request(feature_edges, alpha_smooth, miq)?;
-        let options = SolveOptions { cones: cone_options, param: ParamOptions::default() };
-        let mut report = |p: SolveProgress| {
+    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool, progress: &Function) -> Result<JsValue, JsError> {
+        let schedule = self.solve_begin(feature_edges, alpha_smooth, miq)?;
+        for c in schedule {
+            self.solve_place(c, false, progress)?;
+        }
+        self.solve_finish(progress)
+    }
+
+    /// `solve` in steps, so that another session with the same mesh can place
+    /// some components: `solve_begin`, then `solve_place` for every
+    /// component (here, or elsewhere and handed over with `solve_add`), then
+    /// `solve_finish`. Starts a solve (dropping any unfinished one); returns
+    /// the components in the order to place them (largest first).
+    pub fn solve_begin(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool) -> Result<Vec<u32>, JsError> {
+        self.job = None;
+        let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
+        let stage = ConeStage::new(mesh, &features, &SolveOptions { cones, param: ParamOptions::default() });
+        let schedule = stage.problem().schedule().iter().map(|&c| c as u32).collect();
+        self.job = Some(Job { features, stage, placed: Vec::new() });
+        Ok(schedule)
+    }
+
+    /// Places component `component` of the started solve and keeps it;
+    /// with `share`, also returns it as bytes for `solve_add` in another session.
+    pub fn solve_place(&mut self, component: u32, share: bool, progress: &Function) -> Result<Option<Uint8Array>, JsError> {
+        let job = self.job.as_mut().ok_or_else(|| JsError::new("no solve was started"))?;
+        let problem = job.stage.problem();
+        if component as usize >= problem.n_components() {
+            return Err(JsError::new(&format!("component {component} is out of range ({} components)", problem.n_components())));
+        }
+        let placed = problem.place_component(component as usize, &mut cone_progress(progress)).map_err(|e| JsError::new(&e.to_string()))?;
+        let bytes = share.then(|| Uint8Array::from(&placed.to_json()[..]));
+        job.placed.push(placed);
+        Ok(bytes)
+    }
+
+    /// Adds a component placed by another session (`solve_place` with `share`).
+    pub fn solve_add(&mut self, bytes: &[u8]) -> Result<(), JsError> {
+        let job = self.job.as_mut().ok_or_else(|| JsError::new("no solve was started"))?;
+        job.placed.push(ComponentPlacement::from_json(bytes).map_err(|e| JsError::new(&e.to_string()))?);
+        Ok(())
+    }
+
+    /// Joins the placed components and computes the parametrization (any
+    /// refinement around cones of angle 0 is placed here); returns what
+    /// `solve` returns. Ends the started solve.
+    pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsError> {
+        let Job { features, mut stage, mut placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
+        let mesh = self.valid_mesh()?;
+        let fail = |e: SolveError| JsError::new(&e.to_string());
+        let placed = loop {
+            match stage.finish(mesh, &features, std::mem::take(&mut placed)).map_err(fail)? {
+                ConeStep::Placed(p) => break p,
+                ConeStep::Again(next) => stage = next,
+            }
+            for c in stage.problem().schedule() {
+                placed.push(stage.problem().place_component(c, &mut cone_progress(progress)).map_err(|e| JsError::new(&e.to_string()))?);
+            }
+        };
+        let mut report = |p: ParamProgress| {
             let (stage, a, b) = match p {
-                SolveProgress::Cones(p) => cone_stage(&p),
-                SolveProgress::Param(p) => match p {
-                    ParamProgress::Field => ("cross-field", 0, 0),
-                    ParamProgress::Cut => ("cut", 0, 0),
-                    ParamProgress::Poisson => ("poisson", 0, 0),
-                    ParamProgress::Arap { iteration, max } => ("arap", iteration, max),
-                    ParamProgress::Repair { round, flips } => ("repair", round, flips),
-                    ParamProgress::Injective { iteration, max } => ("injective", iteration, max),
-                },
+                ParamProgress::Field => ("cross-field", 0, 0),
+                ParamProgress::Cut => ("cut", 0, 0),
+                ParamProgress::Poisson => ("poisson", 0, 0),
+                ParamProgress::Arap { iteration, max } => ("arap", iteration, max),
+                ParamProgress::Repair { round, flips } => ("repair", round, flips),
+                ParamProgress::Injective { iteration, max } => ("injective", iteration, max),
             };
             notify(progress, stage, a, b);
         };
-        let sol = pipeline::solve(mesh, &features, &options, &mut report).map_err(|e| JsError::new(&e.to_string()))?;
+        let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
+        self.solution_object(mesh, &sol)
+    }
+}
+
+impl MeshSession {
+    /// The result object of `solve` for the solution `sol` of `mesh`.
+    fn solution_object(&self, mesh: &TriMesh, sol: &Solution) -> Result<JsValue, JsError> {
         let out = cone_result(&sol.placement, sol.features.len())?;
         let uv: Vec<f32> = sol.input_corner_uv(mesh).iter().flat_map(|p| p.map(|c| c as f32)).collect();
         set(&out, "uv", &Float32Array::from(&uv[..]).into())?;
@@ -241,6 +300,14 @@ impl MeshSession {
 /// must not stop the solve, so its error is ignored.
 fn notify(progress: &Function, stage: &str, a: usize, b: usize) {
     let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
+}
+
+/// Forwards cone-placement progress to the page's `progress`.
+fn cone_progress(progress: &Function) -> impl FnMut(Progress) + '_ {
+    move |p| {
+        let (stage, a, b) = cone_stage(&p);
+        notify(progress, stage, a, b);
+    }
 }
 
 /// Stage name and two counters of a cone-placement progress report.

@@ -232,6 +232,23 @@ describe('feature editing and solving', () => {
     await page.locator('input[name=surface][value=shaded]').check();
   });
 
+  it('places some components in a helper worker with the same result', async () => {
+    const alone = (await runSolve()).result;
+    assert.equal(alone.helperComponents, 0, 'the fandisk is below the helper threshold');
+    assert.ok(alone.cones > 0);
+    await page.evaluate(() => window.__conemapTest.setHelper(0, true));
+    try {
+      const h = await runSolve();
+      assert.equal(h.state, 'solved', h.solveError ?? '');
+      assert.ok(h.result.helperComponents > 0, 'the helper placed no component');
+      for (const key of ['cones', 'plus', 'minus', 'sumConeK', 'sumCornerK', 'rounds', 'seams', 'energy']) {
+        assert.equal(h.result[key], alone[key], key);
+      }
+    } finally {
+      await page.evaluate(() => window.__conemapTest.setHelper(50_000, false));
+    }
+  });
+
   it('cancels a running solve at once and solves again afterwards', async (t) => {
     const options = await sampleOptions();
     const big = ['spot.obj', 'bff-bunny.obj'].find((f) => options.includes(f));

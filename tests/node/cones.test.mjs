@@ -61,3 +61,31 @@ test('bad requests give readable errors, not crashes', (t) => {
   // The session still answers after an error.
   assert.equal(sumK(session.place_cones(session.sharp_edges(60), 0.01, false, () => {})), 8);
 });
+
+test('a solve in steps across two sessions equals the one-call solve', () => {
+  const a = open(committedFandisk);
+  const b = open(committedFandisk);
+  const sharp = a.sharp_edges(60);
+  const schedule = a.solve_begin(sharp, 0.01, false);
+  assert.deepEqual([...b.solve_begin(sharp, 0.01, false)], [...schedule]);
+  assert.ok(schedule.length > 2, `${schedule.length} components`);
+  assert.deepEqual([...schedule].sort((x, y) => x - y), [...schedule.keys()], 'every component once');
+  // b places every other component and hands it to a as bytes.
+  schedule.forEach((c, i) => {
+    if (i % 2) a.solve_add(b.solve_place(c, true, () => {}));
+    else assert.equal(a.solve_place(c, false, () => {}), undefined);
+  });
+  const split = a.solve_finish(() => {});
+  const whole = open(committedFandisk).solve(sharp, 0.01, false, () => {});
+  assert.equal(split.energy, whole.energy);
+  assert.deepEqual(split.cones, whole.cones);
+  assert.ok(split.uv.length === whole.uv.length && split.uv.every((v, i) => v === whole.uv[i]), 'same UVs to the bit');
+  assert.equal(split.metrics.flipped, 0);
+  // Misuse gets clear errors and leaves the session usable.
+  assert.throws(() => a.solve_finish(() => {}), /no solve was started/);
+  a.solve_begin(sharp, 0.01, false);
+  assert.throws(() => a.solve_place(schedule.length, false, () => {}), /out of range/);
+  assert.throws(() => a.solve_add(new TextEncoder().encode('{"component": 1}')), /unreadable component result/);
+  assert.throws(() => a.solve_finish(() => {}), /do not fit this mesh/);
+  assert.equal(a.solve(sharp, 0.01, false, () => {}).energy, whole.energy);
+});

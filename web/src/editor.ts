@@ -41,6 +41,10 @@ export interface ResultHook {
   shownCones: string;
   uv: boolean;
   seams: number;
+  /** `phiᵀ(alpha L + M/A) phi` of the placement. */
+  energy: number;
+  /** Components whose cones a helper worker placed. */
+  helperComponents: number;
 }
 
 const $ = <T extends HTMLElement>(id: string): T => {
@@ -594,6 +598,8 @@ export class Editor {
       shownCones: coneText,
       uv: hasUv,
       seams: r.seam_edges?.length ?? 0,
+      energy: r.energy,
+      helperComponents: r.helperComponents ?? 0,
     };
     return true;
   }

@@ -33,6 +33,8 @@ declare global {
       visibleEdge(): number;
       /** Edge id a click at (x, y) would toggle; -1 when none. */
       edgeAt(x: number, y: number): number;
+      /** Smallest mesh (faces) whose solves use a helper worker; `wait`: start placing once it is ready. */
+      setHelper(minFaces: number, wait: boolean): void;
     };
   }
 }
@@ -201,6 +203,10 @@ window.__conemapTest = {
   projectEdge: (e) => editor.projectEdge(e),
   visibleEdge: () => editor.visibleEdge(),
   edgeAt: (x, y) => editor.edgeAt(x, y),
+  setHelper: (minFaces, wait) => {
+    MeshWorker.helperMinFaces = minFaces;
+    MeshWorker.helperWait = wait;
+  },
 };
 
 void listSamples();

@@ -26,7 +26,20 @@ export type Request =
       features: Uint32Array;
       alphaSmooth: number;
       miq: boolean;
-    };
+    }
+  // A solve in steps (so that a helper worker can place some components):
+  // begin → place every component (here, or in a helper and then add) → finish.
+  | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean }
+  /** Places one component; with `share` the result answers `{ bytes }` for `solve-add` elsewhere. */
+  | { id: number; type: 'solve-place'; component: number; share: boolean }
+  | { id: number; type: 'solve-add'; bytes: Uint8Array }
+  /** Answers a `SolveResult`. */
+  | { id: number; type: 'solve-finish' };
+
+/** Answer to `solve-begin`: the components in the order to place them. */
+export interface SolveBegun {
+  schedule: Uint32Array;
+}
 
 export type Stage = 'starting' | 'parsing' | 'analysing' | 'transferring';
 
@@ -124,6 +137,8 @@ export interface SolveResult {
   obj?: Uint8Array;
   /** Display arrays built in the worker from `uv` (present with `uv`; see solve-view.ts). */
   view?: SolveView;
+  /** Components whose cones a second (helper) worker placed; set by the page. */
+  helperComponents?: number;
 }
 
 /**

@@ -3,7 +3,11 @@
 // (terminate + fresh worker). The worker keeps the open mesh as a session; after
 // any replacement the client re-opens the last mesh in the new worker from a
 // kept copy of its file bytes, so later requests keep working.
-import type { ImportResult, Request, Response, SharpResult, SolveResult, Stage, WireFile } from './protocol';
+//
+// Solves run in steps (see protocol.ts): on large meshes a short-lived helper
+// worker opens the same mesh and places some of the cut mesh's components
+// (they are independent), which halves the cone stage on two cores.
+import type { ImportResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
 
 export class WorkerCrashed extends Error {
   override name = 'WorkerCrashed';
@@ -25,16 +29,34 @@ type Body = Request extends infer R ? (R extends { id: number } ? Omit<R, 'id'> 
 
 const copyFiles = (files: WireFile[]): WireFile[] => files.map((f) => ({ name: f.name, bytes: f.bytes.slice(0) }));
 
+/** A helper worker taking part in one solve. */
+interface Helper {
+  worker: MeshWorker;
+  /** Resolves once it has opened the mesh and begun the same solve. */
+  ready: Promise<void>;
+}
+
 export class MeshWorker {
+  /** Meshes with fewer faces solve in one worker: a helper's start-up (wasm, import) would cost more than it saves. */
+  static helperMinFaces = 50_000;
+  /** Test hook: the main worker waits until the helper is ready, so that both surely place components. */
+  static helperWait = false;
+
   private worker: Worker;
   private nextId = 1;
   private pending = new Map<number, Pending>();
   /** Copy of the files of the mesh open in the worker (for re-opening in a new worker). */
   private openFiles: WireFile[] | null = null;
+  private openFaces = 0;
+  /** The helper of the solve in progress. */
+  private helper: MeshWorker | null = null;
+  /** Terminated for good (helpers are never replaced). */
+  private disposed = false;
   /** How many times a dead worker was replaced (for the test hooks). */
   restarts = 0;
 
-  constructor() {
+  /** `replaceOnFailure`: spawn a fresh worker (re-opening the mesh) when this one dies or is cancelled. */
+  constructor(private readonly replaceOnFailure = true) {
     this.worker = this.spawn();
   }
 
@@ -55,6 +77,11 @@ export class MeshWorker {
     this.restarts++;
     const owed = [...this.pending.values()];
     this.pending.clear();
+    if (!this.replaceOnFailure) {
+      this.disposed = true;
+      for (const p of owed) p.reject(reason);
+      return;
+    }
     this.worker = this.spawn();
     if (this.openFiles) {
       // Re-open the current mesh quietly; requests sent after this one wait for it in the worker.
@@ -69,7 +96,13 @@ export class MeshWorker {
 
   /** Stops whatever the worker is doing (the pending requests reject with `Cancelled`). */
   cancel(): void {
+    this.dropHelper();
     this.replace(new Cancelled('cancelled'));
+  }
+
+  private dropHelper(): void {
+    this.helper?.replace(new Cancelled('the solve ended'));
+    this.helper = null;
   }
 
   /** True while a request is in flight. */
@@ -103,6 +136,7 @@ export class MeshWorker {
   private send<T>(body: Body, transfer: Transferable[] = [], onProgress: ProgressFn = () => {}): Promise<T> {
     const id = this.nextId++;
     const request = { ...body, id } as Request;
+    if (this.disposed) return Promise.reject(new Cancelled('this worker was stopped'));
     return new Promise<T>((resolve, reject) => {
       this.pending.set(id, { resolve: resolve as (v: unknown) => void, reject, onProgress });
       this.worker.postMessage(request, [...new Set(transfer)]);
@@ -118,6 +152,7 @@ export class MeshWorker {
       (stage) => onProgress(stage as Stage),
     );
     this.openFiles = kept;
+    this.openFaces = result.indices.length / 3;
     return result;
   }
 
@@ -126,8 +161,74 @@ export class MeshWorker {
     return this.send<SharpResult>({ type: 'sharp', degrees });
   }
 
-  /** Cones (and UVs when the build can) for the open mesh. */
-  solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn): Promise<SolveResult> {
-    return this.send<SolveResult>({ type: 'solve', features, alphaSmooth, miq }, [], onProgress);
+  /**
+   * Cones and UVs for the open mesh, in steps: begin, place every component
+   * (some in a helper worker on large meshes), finish. Progress comes from this
+   * worker (and from the helper once this one has nothing left to place).
+   */
+  async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn): Promise<SolveResult> {
+    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq }, [], onProgress);
+    const queue = Array.from(schedule);
+    const helper = this.startHelper(features, alphaSmooth, miq, schedule);
+    let ownDone = false;
+    let helped = 0;
+    const leftover: number[] = [];
+    // Every request opens with a 'starting' report: not news in the middle of a solve.
+    const placing: ProgressFn = (stage, ...rest) => stage !== 'starting' && onProgress(stage, ...rest);
+    const own = async (): Promise<void> => {
+      if (helper && MeshWorker.helperWait) await helper.ready.catch(() => {});
+      for (let c = queue.shift(); c !== undefined; c = queue.shift()) {
+        await this.send({ type: 'solve-place', component: c, share: false }, [], placing);
+      }
+      ownDone = true;
+    };
+    const help = async (h: Helper): Promise<void> => {
+      const progress: ProgressFn = (...a) => ownDone && placing(...a);
+      try {
+        await h.ready;
+        for (let c = queue.shift(); c !== undefined; c = queue.shift()) {
+          try {
+            const { bytes } = await h.worker.send<{ bytes: Uint8Array }>({ type: 'solve-place', component: c, share: true }, [], progress);
+            await this.send({ type: 'solve-add', bytes }, [bytes.buffer]);
+            helped++;
+          } catch (e) {
+            leftover.push(c);
+            throw e;
+          }
+        }
+      } catch (e) {
+        if (!(e instanceof Cancelled)) {
+          console.warn(`conemap: the helper worker stopped (${e instanceof Error ? e.message : String(e)}); the main worker places the rest`);
+        }
+      } finally {
+        if (this.helper === h.worker) this.dropHelper();
+      }
+    };
+    try {
+      await Promise.all([own(), helper ? help(helper) : null]);
+      for (const c of leftover) await this.send({ type: 'solve-place', component: c, share: false }, [], placing);
+      const result = await this.send<SolveResult>({ type: 'solve-finish' }, [], placing);
+      return { ...result, helperComponents: helped };
+    } finally {
+      if (helper && this.helper === helper.worker) this.dropHelper();
+    }
+  }
+
+  /** A helper for a solve of `schedule`'s components, or null when one would not pay. */
+  private startHelper(features: Uint32Array, alphaSmooth: number, miq: boolean, schedule: Uint32Array): Helper | null {
+    const cores = typeof navigator === 'undefined' ? 2 : (navigator.hardwareConcurrency ?? 2);
+    if (schedule.length < 2 || this.openFaces < MeshWorker.helperMinFaces || !this.openFiles || cores < 2) return null;
+    this.dropHelper();
+    const worker = new MeshWorker(false);
+    const files = copyFiles(this.openFiles);
+    const ready = (async () => {
+      await worker.send({ type: 'import', files, quiet: true }, files.map((f) => f.bytes));
+      const begun = await worker.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq });
+      if (begun.schedule.length !== schedule.length || begun.schedule.some((c, i) => c !== schedule[i])) {
+        throw new Error('the helper sees a different mesh');
+      }
+    })();
+    this.helper = worker;
+    return { worker, ready };
   }
 }

@@ -30,6 +30,10 @@ interface Session {
   sharp_edges(degrees: number): Uint32Array;
   place_cones(features: Uint32Array, alpha: number, miq: boolean, progress: Progress): Omit<SolveResult, 'elapsed'>;
   solve?: (features: Uint32Array, alpha: number, miq: boolean, progress: Progress) => unknown;
+  solve_begin(features: Uint32Array, alpha: number, miq: boolean): Uint32Array;
+  solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
+  solve_add(bytes: Uint8Array): void;
+  solve_finish(progress: Progress): unknown;
   free(): void;
 }
 let session: Session | null = null;
@@ -43,7 +47,7 @@ function errorMessage(e: unknown): string {
   return String(e);
 }
 
-function openMesh(req: Extract<Request, { type: 'import' }>): { value: unknown; transfer: Transferable[] } {
+function openMesh(req: Extract<Request, { type: 'import' }>): Answer {
   const { id } = req;
   post({ id, type: 'progress', stage: 'parsing' });
   const files = req.files.map((f) => ({ name: f.name, bytes: new Uint8Array(f.bytes) }));
@@ -99,59 +103,90 @@ function requireSession(): Session {
   return session;
 }
 
-function solve(req: Extract<Request, { type: 'solve' }>): { value: unknown; transfer: Transferable[] } {
-  const s = requireSession();
-  const { id } = req;
+/** A progress callback that posts at most every 30 ms (rounding can call it thousands of times). */
+function throttledProgress(id: number): Progress {
   let lastPost = 0;
-  const progress: Progress = (stage, step, remaining) => {
-    // Rounding can call this thousands of times: post at most every 30 ms.
+  return (stage, step, remaining) => {
     const now = performance.now();
     if (now - lastPost < 30) return;
     lastPost = now;
     post({ id, type: 'progress', stage, step, remaining });
   };
+}
+
+type Answer = { value: unknown; transfer: Transferable[] };
+
+function solve(req: Extract<Request, { type: 'solve' }>): Answer {
+  const s = requireSession();
+  const progress = throttledProgress(req.id);
   const t0 = performance.now();
-  post({ id, type: 'progress', stage: 'starting', step: 0, remaining: 0 });
-  if (typeof s.solve === 'function') {
-    const raw = s.solve(req.features, req.alphaSmooth, req.miq, progress) as Record<string, unknown>;
-    // The result may be a plain object or a wasm-bindgen class (getters / methods on
-    // its prototype): read the known fields and any own ones, calling methods.
-    const keys = new Set([
-      'cones', 'boundary_corners', 'components', 'rounds', 'energy', 'phi_rms', 'timings', 'feature_edges',
-      'uv', 'seam_edges', 'metrics', 'glb', 'obj', ...Object.keys(raw),
-    ]);
-    const out: Record<string, unknown> = {};
-    for (const key of keys) {
-      if (key.startsWith('__') || key === 'free') continue;
-      let v: unknown;
-      try {
-        v = raw[key];
-        if (typeof v === 'function') v = (v as () => unknown).call(raw);
-      } catch (e) {
-        console.warn(`conemap: reading ${key} of the solve result failed: ${errorMessage(e)}`);
-        continue;
-      }
-      if (v !== undefined && typeof v !== 'function') out[key] = v;
-    }
-    if (typeof raw['free'] === 'function') (raw['free'] as () => void).call(raw);
-    if (Array.isArray(out['uv'])) out['uv'] = Float32Array.from(out['uv'] as number[]);
-    if (Array.isArray(out['seam_edges'])) out['seam_edges'] = Uint32Array.from(out['seam_edges'] as number[]);
-    if (typeof out['obj'] === 'string') out['obj'] = new TextEncoder().encode(out['obj']);
-    const metrics = out['metrics'] as Record<string, unknown> | undefined;
-    if (metrics && Array.isArray(metrics['per_face_distortion'])) {
-      metrics['per_face_distortion'] = Float32Array.from(metrics['per_face_distortion'] as number[]);
-    }
-    const solved = out as unknown as SolveResult;
-    const view = solveView(s, solved);
-    const value: SolveResult = { ...solved, ...(view ? { view } : {}), elapsed: performance.now() - t0 };
-    const transfer: Transferable[] = view ? viewBuffers(view) : [];
-    for (const v of [value.uv, value.seam_edges, value.glb, value.obj, value.metrics?.per_face_distortion]) {
-      if (v && ArrayBuffer.isView(v) && v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
-    }
-    return { value, transfer };
-  }
+  post({ id: req.id, type: 'progress', stage: 'starting', step: 0, remaining: 0 });
+  if (typeof s.solve === 'function') return solveAnswer(s, s.solve(req.features, req.alphaSmooth, req.miq, progress), t0);
   const r = s.place_cones(req.features, req.alphaSmooth, req.miq, progress);
   return { value: { ...r, elapsed: performance.now() - t0 }, transfer: [] };
+}
+
+/** When the current stepwise solve began (`elapsed` of its result counts from there). */
+let stepsStart = 0;
+
+function solveStep(req: Extract<Request, { type: 'solve-begin' | 'solve-place' | 'solve-add' | 'solve-finish' }>): Answer {
+  const s = requireSession();
+  switch (req.type) {
+    case 'solve-begin': {
+      stepsStart = performance.now();
+      const schedule = s.solve_begin(req.features, req.alphaSmooth, req.miq);
+      return { value: { schedule }, transfer: [schedule.buffer] };
+    }
+    case 'solve-place': {
+      const bytes = s.solve_place(req.component, req.share, throttledProgress(req.id)) ?? null;
+      return { value: { bytes }, transfer: bytes ? [bytes.buffer] : [] };
+    }
+    case 'solve-add':
+      s.solve_add(req.bytes);
+      return { value: null, transfer: [] };
+    case 'solve-finish':
+      return solveAnswer(s, s.solve_finish(throttledProgress(req.id)), stepsStart);
+  }
+}
+
+/** The `SolveResult` of a wasm solve result `raw` (freed here), with its view; `t0`: when the solve began. */
+function solveAnswer(s: Session, raw0: unknown, t0: number): Answer {
+  const raw = raw0 as Record<string, unknown>;
+  // The result may be a plain object or a wasm-bindgen class (getters / methods on
+  // its prototype): read the known fields and any own ones, calling methods.
+  const keys = new Set([
+    'cones', 'boundary_corners', 'components', 'rounds', 'energy', 'phi_rms', 'timings', 'feature_edges',
+    'uv', 'seam_edges', 'metrics', 'glb', 'obj', ...Object.keys(raw),
+  ]);
+  const out: Record<string, unknown> = {};
+  for (const key of keys) {
+    if (key.startsWith('__') || key === 'free') continue;
+    let v: unknown;
+    try {
+      v = raw[key];
+      if (typeof v === 'function') v = (v as () => unknown).call(raw);
+    } catch (e) {
+      console.warn(`conemap: reading ${key} of the solve result failed: ${errorMessage(e)}`);
+      continue;
+    }
+    if (v !== undefined && typeof v !== 'function') out[key] = v;
+  }
+  if (typeof raw['free'] === 'function') (raw['free'] as () => void).call(raw);
+  if (Array.isArray(out['uv'])) out['uv'] = Float32Array.from(out['uv'] as number[]);
+  if (Array.isArray(out['seam_edges'])) out['seam_edges'] = Uint32Array.from(out['seam_edges'] as number[]);
+  if (typeof out['obj'] === 'string') out['obj'] = new TextEncoder().encode(out['obj']);
+  const metrics = out['metrics'] as Record<string, unknown> | undefined;
+  if (metrics && Array.isArray(metrics['per_face_distortion'])) {
+    metrics['per_face_distortion'] = Float32Array.from(metrics['per_face_distortion'] as number[]);
+  }
+  const solved = out as unknown as SolveResult;
+  const view = solveView(s, solved);
+  const value: SolveResult = { ...solved, ...(view ? { view } : {}), elapsed: performance.now() - t0 };
+  const transfer: Transferable[] = view ? viewBuffers(view) : [];
+  for (const v of [value.uv, value.seam_edges, value.glb, value.obj, value.metrics?.per_face_distortion]) {
+    if (v && ArrayBuffer.isView(v) && v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
+  }
+  return { value, transfer };
 }
 
 /**
@@ -186,7 +221,7 @@ async function handle(req: Request): Promise<void> {
       post({ id, type: 'error', message: `could not load the wasm module: ${errorMessage(e)}`, fatal: true });
       return;
     }
-    let out: { value: unknown; transfer: Transferable[] };
+    let out: Answer;
     switch (req.type) {
       case 'import':
         out = openMesh(req);
@@ -198,6 +233,12 @@ async function handle(req: Request): Promise<void> {
       }
       case 'solve':
         out = solve(req);
+        break;
+      case 'solve-begin':
+      case 'solve-place':
+      case 'solve-add':
+      case 'solve-finish':
+        out = solveStep(req);
         break;
     }
     post({ id, type: 'result', value: out.value }, out.transfer);

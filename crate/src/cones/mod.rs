@@ -11,18 +11,18 @@
 pub mod dual_tree;
 pub mod frames;
 pub mod harmonic;
+pub mod problem;
 pub mod system;
 #[cfg(test)]
 pub(crate) mod test_meshes;
 
 use crate::clock::Stopwatch;
-use crate::features::{cut_open, CutMesh, FeatureSet};
+use crate::features::{CutMesh, FeatureSet};
 use crate::mesh::TriMesh;
-use frames::{Frames, Visit};
-use serde::Serialize;
+pub use problem::{ComponentPlacement, ConeProblem, MismatchError};
+use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
 pub use system::ConeError;
-use system::{ComponentSystem, Weights};
 
 /// Default `alpha_smooth` (paper: 0.01 in most figures).
 pub const DEFAULT_ALPHA: f64 = 0.01;
@@ -96,7 +96,7 @@ pub struct ConeTimings {
 }
 
 /// Per-component figures.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ComponentCones {
     pub euler_characteristic: i64,
     pub boundary_loops: usize,
@@ -144,6 +144,8 @@ pub struct ConePlacement {
 }
 
 /// Places cones on `mesh` with features `features` cut open (section 5).
+/// Natively the components are placed on two threads (they are independent);
+/// `progress` hears about the components placed on the calling thread.
 pub fn place_cones(
     mesh: &TriMesh,
     features: &FeatureSet,
@@ -151,104 +153,44 @@ pub fn place_cones(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ConePlacement, ConeError> {
     let mut clock = Stopwatch::start();
-    let mut timings = ConeTimings::default();
-    let cut = cut_open(mesh, features);
-    timings.cut = clock.lap();
-    let cm = &cut.mesh;
-    let frames = Frames::new(cm);
-    let boundary_k = boundary_turning(cm);
-    let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
+    let problem = ConeProblem::new(mesh, features, options);
+    let results = place_all(&problem, progress)?;
+    let mut placement = problem.assemble(mesh, results).expect("components placed here fit their problem");
+    placement.timings.total = clock.lap();
+    Ok(placement)
+}
 
-    let nv = cm.n_vertices();
-    let mut k = vec![0i32; nv];
-    let mut phi = vec![0.0; nv];
-    let mut omega = vec![0.0; 3 * cm.n_faces()];
-    let mut components = Vec::new();
-    let (mut energy, mut phi2_area, mut total_area, mut rounds) = (0.0, 0.0, 0.0, 0);
-    let n_comp = cm.n_components();
-    let mut seeds = vec![u32::MAX; n_comp];
-    for (f, &c) in cm.face_components().iter().enumerate() {
-        if seeds[c as usize] == u32::MAX {
-            seeds[c as usize] = f as u32;
-        }
-    }
-    for (c, &seed) in seeds.iter().enumerate() {
-        progress(Progress::Topology { component: c, components: n_comp });
-        let mut sys = ComponentSystem::new(cm, &frames, seed, &boundary_k, weights)?;
-        timings.topology += clock.lap();
-        sys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free }))?;
-        timings.rounding += clock.lap();
-        let moves = if options.optimize_locations {
-            sys.optimize_locations(options.max_move_passes, &mut |pass| {
-                progress(Progress::ConeMoves { component: c, pass })
-            })?
-        } else {
-            0
-        };
-        let merged = if options.merge_close_pairs { sys.merge_close_pairs()? } else { 0 };
-        let cancelled = if options.cancel_pairs_nearest > 0 {
-            sys.cancel_pairs(options.cancel_pairs_nearest, &mut |n| progress(Progress::PairCancellation { component: c, removed: n }))?
-        } else {
-            0
-        };
-        timings.cone_moves += clock.lap();
-
-        let kv = sys.vertex_k();
-        let local_phi = sys.phi().to_vec();
-        let h = sys.h();
-        for (i, &v) in sys.tree.vertices.iter().enumerate() {
-            k[v as usize] = kv[i] as i32;
-            phi[v as usize] = local_phi[i];
-        }
-        for &f in &sys.tree.faces {
-            let hs = cm.face_halfedges(f);
-            let tri = cm.faces()[f as usize];
-            for i in 0..3 {
-                let visit = Visit { h_in: hs[i], h_out: hs[(i + 1) % 3] };
-                let coef = frames.segment_phi_coefficients(cm, visit);
-                let mut w: f64 = (0..3).map(|j| coef[j] * phi[tri[j] as usize]).sum();
-                for (j, hj) in h.iter().enumerate() {
-                    w += hj * sys.basis.segment(j, visit);
+/// Places every component of `problem`, largest first; natively on two
+/// threads pulling from one queue, in wasm32 one after the other.
+pub fn place_all(problem: &ConeProblem, progress: &mut dyn FnMut(Progress)) -> Result<Vec<ComponentPlacement>, ConeError> {
+    let order = problem.schedule();
+    #[cfg(not(target_arch = "wasm32"))]
+    if order.len() > 1 {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let next = AtomicUsize::new(0);
+        let drain = |progress: &mut dyn FnMut(Progress)| -> Result<Vec<ComponentPlacement>, ConeError> {
+            let mut out = Vec::new();
+            while let Some(&c) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                match problem.place_component(c, progress) {
+                    Ok(r) => out.push(r),
+                    Err(e) => {
+                        next.store(order.len(), Ordering::Relaxed); // the other thread stops too
+                        return Err(e);
+                    }
                 }
-                omega[3 * f as usize + i] = w;
             }
-        }
-        let area: f64 = sys.tree.faces.iter().map(|&f| frames.area(f)).sum();
-        energy += sys.energy(options.alpha_smooth);
-        phi2_area += sys.phi_norm2() * area;
-        total_area += area;
-        rounds += sys.rounds;
-        let comp_index = c;
-        components.push(ComponentCones {
-            euler_characteristic: cm.component_euler_characteristic(comp_index),
-            boundary_loops: cm.component_boundary_loops(comp_index),
-            genus: cm.genus(comp_index),
-            k_sum: kv.iter().sum(),
-            path_integers: sys.tree.leftovers.iter().map(|&e| sys.fixed[sys.tree.g_index[e as usize] as usize].unwrap_or(0)).collect(),
-            h,
-            rounds: sys.rounds,
-            moves,
-            merged_pairs: merged,
-            cancelled_pairs: cancelled,
-            residual: sys.residual,
-            refinement_steps: sys.refinement_steps,
+            Ok(out)
+        };
+        return std::thread::scope(|scope| {
+            let helper = scope.spawn(|| drain(&mut |_| {}));
+            let mine = drain(progress);
+            let theirs = helper.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            let mut all = mine?;
+            all.extend(theirs?);
+            Ok(all)
         });
     }
-    let (cones, boundary_corners) = original_cones(mesh, &cut, &k);
-    timings.total = timings.cut + timings.topology + timings.rounding + timings.cone_moves;
-    Ok(ConePlacement {
-        cut,
-        k,
-        phi,
-        omega,
-        cones,
-        boundary_corners,
-        components,
-        energy,
-        phi_rms: (phi2_area / total_area.max(f64::MIN_POSITIVE)).sqrt(),
-        rounds,
-        timings,
-    })
+    order.iter().map(|&c| problem.place_component(c, progress)).collect()
 }
 
 /// Turning integer of every boundary vertex, rounded from the geometry:
