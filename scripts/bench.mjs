@@ -387,7 +387,7 @@ async function browserSolveBig(ctx) {
     await page.waitForFunction((k) => window.__conemap.solves > k, solves, { timeout: 1_800_000, polling: 500 });
     const ms = Date.now() - t0;
     const h = await page.evaluate(() => { window.__bench.running = false; return { result: window.__conemap.result, error: window.__conemap.solveError, gap: window.__bench.maxGap }; });
-    const note = h.result ? `${h.result.cones} cones, ${h.result.uv ? 'UVs' : 'no UVs'}` : `failed: ${h.error}`;
+    const note = h.result ? `${h.result.cones} cones, ${h.result.uv ? 'UVs' : 'no UVs'}, ${h.result.helperComponents} components placed by the helper worker` : `failed: ${h.error}`;
     // For scale: one plain redraw of the solved 3D view (the Frame button), median of 3.
     const redraws = [];
     for (let i = 0; i < 3; i++) {
