@@ -3,7 +3,7 @@
 //! of angle 0 and placing them again —, then compute the seamless aligned
 //! parametrization (Appendix B). The CLI and the wasm API call this.
 
-use crate::clock::Stopwatch;
+use crate::clock::{now_seconds, Stopwatch};
 use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
 use crate::features::{split_around, split_doubly_constrained, FeatureSet, Refined};
 use crate::mesh::TriMesh;
@@ -138,6 +138,8 @@ pub struct ConeStage {
     /// Refinements around cones of angle 0 made so far.
     attempt: usize,
     refine_seconds: f64,
+    /// When the stage began (`clock::now_seconds`).
+    started: f64,
     problem: ConeProblem,
 }
 
@@ -163,10 +165,10 @@ pub struct Placed {
 impl ConeStage {
     /// Splits doubly constrained triangles and prepares the cone problem.
     pub fn new(mesh: &TriMesh, features: &FeatureSet, options: &SolveOptions) -> ConeStage {
-        let mut clock = Stopwatch::start();
+        let started = now_seconds();
         let refined = split_doubly_constrained(mesh, features);
-        let refine_seconds = clock.lap();
-        ConeStage::with_refinement(mesh, features, options, refined, 0, refine_seconds)
+        let refine_seconds = now_seconds() - started;
+        ConeStage::with_refinement(mesh, features, options, refined, 0, refine_seconds, started)
     }
 
     fn with_refinement(
@@ -176,10 +178,11 @@ impl ConeStage {
         refined: Option<Refined>,
         attempt: usize,
         refine_seconds: f64,
+        started: f64,
     ) -> ConeStage {
         let (m, f) = refined.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
         let problem = ConeProblem::new(m, f, &options.cones);
-        ConeStage { options: *options, refined, attempt, refine_seconds, problem }
+        ConeStage { options: *options, refined, attempt, refine_seconds, started, problem }
     }
 
     /// The components to place.
@@ -188,20 +191,24 @@ impl ConeStage {
     }
 
     /// Joins the placed components (one per component of
-    /// [`Self::problem`]); refines around cones of angle 0 while attempts remain.
+    /// [`Self::problem`]); refines around cones of angle 0 while attempts
+    /// remain. The placement's `timings.total` is the stage's wall-clock time
+    /// without the refinements (components may have run in parallel, so the
+    /// per-stage timings can add up to more).
     pub fn finish(self, mesh: &TriMesh, features: &FeatureSet, results: Vec<ComponentPlacement>) -> Result<ConeStep, SolveError> {
-        let ConeStage { options, refined, attempt, mut refine_seconds, problem } = self;
+        let ConeStage { options, refined, attempt, mut refine_seconds, started, problem } = self;
         let m = refined.as_ref().map_or(mesh, |r| &r.mesh);
-        let placement = problem.assemble(m, results).map_err(SolveError::Components)?;
+        let mut placement = problem.assemble(m, results).map_err(SolveError::Components)?;
         let degenerate = zero_angle_cones(&placement);
         if degenerate.is_empty() || attempt == MAX_CONE_REFINEMENTS {
+            placement.timings.total = now_seconds() - started - refine_seconds;
             return Ok(ConeStep::Placed(Placed { options, refined, refine_seconds, placement }));
         }
         // Only vertices of `m` are named; lift the refinement one level.
         let mut clock = Stopwatch::start();
         let refined = Some(split_around(mesh, features, refined, &degenerate));
         refine_seconds += clock.lap();
-        Ok(ConeStep::Again(ConeStage::with_refinement(mesh, features, &options, refined, attempt + 1, refine_seconds)))
+        Ok(ConeStep::Again(ConeStage::with_refinement(mesh, features, &options, refined, attempt + 1, refine_seconds, started)))
     }
 }
 

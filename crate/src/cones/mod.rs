@@ -85,7 +85,8 @@ pub struct Cone {
     pub position: [f64; 3],
 }
 
-/// Seconds per stage.
+/// Seconds per stage. Components can be placed in parallel: `topology`,
+/// `rounding` and `cone_moves` add up over components, `total` is wall-clock.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct ConeTimings {
     pub cut: f64,

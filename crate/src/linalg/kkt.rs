@@ -3,7 +3,7 @@
 //! with `A` (n × n) symmetric positive semi-definite and `C` (m × n) the
 //! constraint rows, and a one-off convenience solve.
 
-use super::cholesky::{LdltSolver, SolveInfo};
+use super::cholesky::{LdltSolver, SolveInfo, SparseSpd};
 use super::pattern::{SymmetricPattern, Triplet};
 use super::SolveError;
 
@@ -126,4 +126,67 @@ pub fn solve_kkt(
     let (mut x, info) = solver.solve_with_info(&rhs)?;
     let lambda = x.split_off(n);
     Ok(KktSolution { x, lambda, info })
+}
+
+/// Orthogonal projection onto the null space of a full-row-rank constraint
+/// matrix `C` (m × n): `y -> y - Cᵀ (C Cᵀ)⁻¹ C y`, with `C Cᵀ` factored once.
+/// Cheap next to a KKT solve (`C Cᵀ` couples only rows sharing an unknown),
+/// it puts an inexact KKT solution of a homogeneous system back onto `C y = 0`.
+pub struct NullSpaceProjector {
+    n: usize,
+    m: usize,
+    c: Vec<(usize, usize, f64)>,
+    gram: SparseSpd,
+}
+
+impl NullSpaceProjector {
+    /// Factors `C Cᵀ` for the triplets `c` (`(row, unknown, value)`, rows
+    /// `0..m`, unknowns `0..n`); fails when the factorization finds `C Cᵀ` singular.
+    pub fn new(c: &[Triplet], n: usize, m: usize) -> Result<Self, SolveError> {
+        let mut by_unknown: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        for &(r, j, v) in c {
+            if r >= m || j >= n {
+                return Err(SolveError::IndexOutOfBounds { row: r, col: j, n: m.max(n) });
+            }
+            by_unknown[j].push((r, v));
+        }
+        let mut t = Vec::new();
+        for col in &by_unknown {
+            for &(r1, v1) in col {
+                t.extend(col.iter().filter(|e| r1 <= e.0).map(|&(r2, v2)| (r1, r2, v1 * v2)));
+            }
+        }
+        Ok(Self { n, m, c: c.to_vec(), gram: SparseSpd::from_triplets(m, &t)? })
+    }
+
+    /// `C y` per row.
+    pub fn residual(&self, y: &[f64]) -> Vec<f64> {
+        let mut res = vec![0.0f64; self.m];
+        for &(row, col, v) in &self.c {
+            res[row] += v * y[col];
+        }
+        res
+    }
+
+    /// Projects `y` (length `n`) onto `C y = 0` in place, repeating (at most
+    /// `passes` times) while `max |C y| > tolerance · max |y|`; true once
+    /// below it (false also on a length mismatch or a failed solve).
+    pub fn project(&self, y: &mut [f64], tolerance: f64, passes: usize) -> bool {
+        if y.len() != self.n {
+            return false;
+        }
+        let max_abs = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let size = max_abs(y).max(f64::MIN_POSITIVE);
+        for _ in 0..passes {
+            let res = self.residual(y);
+            if max_abs(&res) <= tolerance * size {
+                return true;
+            }
+            let Ok(l) = self.gram.solve(&res) else { return false };
+            for &(row, col, v) in &self.c {
+                y[col] -= v * l[row];
+            }
+        }
+        y.iter().all(|v| v.is_finite()) && max_abs(&self.residual(y)) <= tolerance * size
+    }
 }

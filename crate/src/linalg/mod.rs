@@ -25,7 +25,7 @@ mod tests;
 
 pub use bordered::FixBorder;
 pub use cholesky::{Fronts, Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
-pub use kkt::{solve_kkt, Kkt, KktSolution};
+pub use kkt::{solve_kkt, Kkt, KktSolution, NullSpaceProjector};
 pub use pattern::{SymmetricPattern, Triplet, IGNORED_SLOT};
 
 use std::fmt;

@@ -322,3 +322,25 @@ fn degenerate_sizes() {
     let spd = SparseSpd::from_triplets(0, &[]).unwrap();
     assert!(spd.solve(&[]).unwrap().is_empty());
 }
+
+#[test]
+fn null_space_projection_is_orthogonal() {
+    // Two rows on four unknowns: x0 - x1 = 0, x1 + x2 - 2 x3 = 0.
+    let c = [(0, 0, 1.0), (0, 1, -1.0), (1, 1, 1.0), (1, 2, 1.0), (1, 3, -2.0)];
+    let p = NullSpaceProjector::new(&c, 4, 2).unwrap();
+    let y0 = [1.0, -2.0, 0.5, 3.0];
+    let mut y = y0;
+    assert!(p.project(&mut y, 1e-15, 3));
+    assert!(p.residual(&y).iter().all(|r| r.abs() < 1e-14));
+    // The removed part lies in the row space: orthogonal to every null vector.
+    let d: Vec<f64> = y0.iter().zip(&y).map(|(a, b)| a - b).collect();
+    for z in [[1.0, 1.0, 1.0, 1.0], [1.0, 1.0, -1.0, 0.0]] {
+        assert!(d.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>().abs() < 1e-14);
+    }
+    // A feasible vector is left alone; a wrong length is refused.
+    let mut f = [1.0, 1.0, 1.0, 1.0];
+    assert!(p.project(&mut f, 1e-15, 3) && f == [1.0, 1.0, 1.0, 1.0]);
+    assert!(!p.project(&mut [0.0; 3], 1e-15, 3));
+    // Rank-deficient rows are refused.
+    assert!(NullSpaceProjector::new(&[(0, 0, 1.0), (1, 0, 2.0)], 2, 2).is_err());
+}

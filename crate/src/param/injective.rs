@@ -9,10 +9,16 @@
 //! (minus its minimum 4), which is infinite on degenerate triangles and so a
 //! barrier against flips. (Optionally the ARAP term is replaced by a
 //! smoothed version of eq. (19)'s summand, [`Density`]: lower mean
-//! distortion, more concentrated, fewer triangles below 0.3 on some meshes.) Every iteration solves a weighted version of (23),
-//! `min sum_f A_f |W_f (grad f - R_f)|^2`, under the same exact linear
-//! constraints (seam transitions, isolines, pins), then line-searches along
-//! the step with a maximal step that keeps every triangle's signed UV area
+//! distortion, more concentrated, fewer triangles below 0.3 on some meshes.)
+//!
+//! Every iteration minimises a quadratic proxy of `E`: SLIM's
+//! `sum_f A_f |W_f (grad (f + d) - R_f)|^2` with `W_f^T W_f` replaced by its
+//! largest eigenvalue `w_f` times the identity (the same gradient at `f`, a
+//! larger Hessian, so still a descent step). That is a weighted version of
+//! (23) whose u and v blocks are coupled only through the constraints: its
+//! factor is half the size of SLIM's proxy's. Steps keep the same exact
+//! linear constraints (seam transitions, isolines, pins); a line search then
+//! starts from the largest step that keeps every triangle's signed UV area
 //! positive. The constraints are homogeneous, so every iterate stays feasible.
 //! Started from a fold-free map, no triangle flips and the UV angle sum at
 //! every vertex (a continuous function of the iterate while no triangle
@@ -20,7 +26,7 @@
 
 use super::seamless::Element;
 use super::ParamError;
-use crate::linalg::{Fronts, Kkt, LdltSolver, SolverOptions, Triplet};
+use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector, SolverOptions, Triplet};
 
 /// Iterations over which the energy decrease is averaged for the stop test:
 /// a step limited by one nearly degenerate triangle can gain little while the
@@ -30,11 +36,12 @@ pub const STALL_WINDOW: usize = 5;
 /// Iterations per factorization of the proxy matrix (see [`Refiner::refine`]).
 const REFACTOR_EVERY: usize = 5;
 
-/// Most correction solves that push a step back onto the constraints.
-const FEASIBILITY_CORRECTIONS: usize = 6;
+/// Most projections that push a step back onto the constraints.
+const FEASIBILITY_PASSES: usize = 3;
 
-/// Relative residual the global step's solve is refined to.
-const STEP_TOLERANCE: f64 = 1e-8;
+/// `max |C d| / max |d|` a step is projected down to: over the 60 iterations
+/// the iterate must stay on the constraints to ~1e-12 of its size.
+const FEASIBILITY_TOLERANCE: f64 = 1e-14;
 
 /// A 2×2 matrix, row-major.
 type Mat2 = [[f64; 2]; 2];
@@ -129,10 +136,11 @@ impl Density {
         }
     }
 
-    /// Local step: the SPD matrix `M = W^T W = U diag(w_1^2, w_2^2) U^T` and
-    /// the closest rotation `R` with `2 M (J - R) = grad psi(J)`, from the SLIM
-    /// weights `w_i^2 = (d psi / d sigma_i) / (2 (sigma_i - 1))`; `None` when `det J <= 0`.
-    fn proxy(&self, j: Mat2) -> Option<(Mat2, Mat2)> {
+    /// Local step: the SPD matrix `M = W^T W = U diag(w_1^2, w_2^2) U^T`, the
+    /// closest rotation `R` with `2 M (J - R) = grad psi(J)`, from the SLIM
+    /// weights `w_i^2 = (d psi / d sigma_i) / (2 (sigma_i - 1))`, and the
+    /// largest eigenvalue `max w_i^2` of `M`; `None` when `det J <= 0`.
+    fn proxy(&self, j: Mat2) -> Option<(Mat2, Mat2, f64)> {
         let s = svd(j)?;
         let d: f64 = s.sigma.iter().map(|&x| (x - 1.0).powi(2)).sum();
         let base = if self.eps.is_finite() { self.eps / (self.eps * self.eps + d).sqrt() } else { 1.0 };
@@ -141,7 +149,8 @@ impl Density {
         let (m, t) = (0.5 * (w[0] + w[1]), 0.5 * (w[0] - w[1]));
         let (c, sn) = (s.dir2[0], s.dir2[1]);
         let mm = [[m + t * c, t * sn], [t * sn, m - t * c]];
-        mm.iter().flatten().all(|v| v.is_finite()).then_some((mm, s.rot))
+        let w_max = w[0].max(w[1]);
+        (mm.iter().flatten().all(|v| v.is_finite()) && w_max.is_finite()).then_some((mm, s.rot, w_max))
     }
 }
 
@@ -207,25 +216,28 @@ pub fn max_step(p: [[f64; 2]; 3], q: [[f64; 2]; 3]) -> f64 {
     t
 }
 
-/// The reweighted global step of SLIM on the constrained system: the KKT
-/// matrix `[[A(W), C^T], [C, 0]]` with `u`–`v` coupling inside every face,
-/// analysed once and refactored with new weights every iteration.
+/// The reweighted global step on the constrained system: the KKT matrix
+/// `[[A(w), C^T], [C, 0]]` of (23) with face weights `w_f` (module doc),
+/// analysed once and refactored with new weights every few iterations.
 pub(super) struct Refiner<'a> {
     elements: &'a [Element],
     n: usize,
     constraints: &'a [Triplet],
     kkt: Kkt,
     solver: LdltSolver,
-    /// Slot of every triplet (`36` per face, then the constraints) in `kkt.values`.
+    /// Slot of every triplet ([`PER_FACE`] per face, then the constraints) in `kkt.values`.
     slots: Vec<usize>,
     values: Vec<f64>,
+    /// Puts every step back onto `C d = 0` (the factor's solve leaves it off by
+    /// the regularization, ~1e-8 relative to the step).
+    projector: NullSpaceProjector,
 }
 
 impl<'a> Refiner<'a> {
     /// Builds the pattern for `elements` (unknowns `0..n`) and the `m`
     /// constraint rows `constraints` (`(row, unknown, value)`, homogeneous).
     pub(super) fn new(elements: &'a [Element], n: usize, constraints: &'a [Triplet], m: usize) -> Result<Self, ParamError> {
-        let mut a = Vec::with_capacity(36 * elements.len());
+        let mut a = Vec::with_capacity(PER_FACE * elements.len());
         for el in elements {
             for_pairs(el, |i, j| a.push((i, j, if i == j { 1.0 } else { 0.0 })));
         }
@@ -234,12 +246,13 @@ impl<'a> Refiner<'a> {
         t.extend(constraints.iter().map(|&(r, c, v)| (c, n + r, v)));
         let slots = kkt.pattern.slot_map(&t)?;
         let values = t.iter().map(|e| e.2).collect();
-        // The triplets (36 per face) are the largest temporary: free them
-        // before the factor is allocated (wasm memory never shrinks).
+        // The triplets are the largest temporary: free them before the
+        // factor is allocated (wasm memory never shrinks).
         drop(t);
-        let mut solver = LdltSolver::with_fronts(&kkt.pattern, &kkt.signs, Fronts::Dense)?;
-        solver.set_options(SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-6, ..SolverOptions::default() });
-        Ok(Refiner { elements, n, constraints, kkt, solver, slots, values })
+        let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs)?;
+        solver.set_options(SolverOptions { delta: 1e-11, ..SolverOptions::default() });
+        let projector = NullSpaceProjector::new(constraints, n, m)?;
+        Ok(Refiner { elements, n, constraints, kkt, solver, slots, values, projector })
     }
 
     /// Minimises `E` (module doc) from the fold-free `x` (unknowns, length `n`,
@@ -275,16 +288,16 @@ impl<'a> Refiner<'a> {
             let mut proxy_ok = true;
             for (f, el) in self.elements.iter().enumerate() {
                 let j = jacobian(el, x);
-                let Some((mm, rot)) = psi.proxy(j) else {
+                let Some((mm, rot, w_max)) = psi.proxy(j) else {
                     proxy_ok = false;
                     break;
                 };
                 if refresh {
                     // The matrix values: only a refactorization reads them.
-                    let base = 36 * f;
+                    let base = PER_FACE * f;
                     let mut s = 0;
-                    for_pairs_full(|c, k, c2, k2| {
-                        self.values[base + s] = el.area * mm[c][c2] * (el.g[k][0] * el.g[k2][0] + el.g[k][1] * el.g[k2][1]);
+                    for_pairs_full(|_, k, k2| {
+                        self.values[base + s] = el.area * w_max * (el.g[k][0] * el.g[k2][0] + el.g[k][1] * el.g[k2][1]);
                         s += 1;
                     });
                 }
@@ -304,7 +317,7 @@ impl<'a> Refiner<'a> {
             if !proxy_ok {
                 break;
             }
-            debug_assert_eq!(self.values.len(), 36 * nf + self.constraints.len());
+            debug_assert_eq!(self.values.len(), PER_FACE * nf + self.constraints.len());
             // Global step: the step d (C d = 0) minimising the proxy. A
             // numerical failure ends the refinement at the current iterate.
             let Some(d) = self.step(&rhs, refresh) else {
@@ -367,65 +380,32 @@ impl<'a> Refiner<'a> {
             self.kkt.pattern.fill_values_with_slots(&self.slots, &self.values, &mut self.kkt.values).ok()?;
             self.solver.factorize(&self.kkt.values).ok()?;
         }
-        // A descent direction needs no more (make_feasible restores C d = 0).
-        let sol = self.solver.solve_many_to(rhs, 1, STEP_TOLERANCE).ok()?.0;
+        // A descent direction needs no refinement; only C d = 0 must hold,
+        // which the projection restores (the regularized factor's solve is
+        // off by ~1e-8 of the step).
+        let sol = self.solver.solve_unrefined(rhs).ok()?;
         let mut d = sol[..self.n].to_vec();
-        (d.iter().all(|v| v.is_finite()) && self.make_feasible(&mut d)).then_some(d)
-    }
-
-    /// `C y` per constraint row.
-    fn constraint_rows(&self, y: &[f64]) -> Vec<f64> {
-        let mut res = vec![0.0f64; self.kkt.m];
-        for &(row, col, v) in self.constraints {
-            res[row] += v * y[col];
-        }
-        res
-    }
-
-    /// Pushes the step `d` back onto `C d = 0` (correction solves with the
-    /// current factor while the solve left `|C d| > 1e-14 |d|`, at most
-    /// [`FEASIBILITY_CORRECTIONS`]); false when that fails, so the step must
-    /// be discarded.
-    fn make_feasible(&self, d: &mut [f64]) -> bool {
-        let size = max_abs(d).max(f64::MIN_POSITIVE);
-        for _ in 0..FEASIBILITY_CORRECTIONS {
-            let res = self.constraint_rows(d);
-            if max_abs(&res) <= 1e-14 * size {
-                return true;
-            }
-            let mut rhs = vec![0.0; self.n];
-            rhs.extend(res.iter().map(|v| -v));
-            // Each correction is a plain factor solve: they act as the
-            // refinement steps of this small right-hand side.
-            let Ok(corr) = self.solver.solve_unrefined(&rhs) else { return false };
-            for (di, ci) in d.iter_mut().zip(&corr) {
-                *di += ci;
-            }
-        }
-        d.iter().all(|v| v.is_finite()) && max_abs(&self.constraint_rows(d)) <= 1e-14 * size
+        (d.iter().all(|v| v.is_finite()) && self.projector.project(&mut d, FEASIBILITY_TOLERANCE, FEASIBILITY_PASSES)).then_some(d)
     }
 }
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
+/// Matrix entries per face: the 3×3 stiffness block of u and that of v.
+const PER_FACE: usize = 18;
 
-/// Calls `f(c, k, c2, k2)` for the 36 pairs of (component, corner) of a face, in a fixed order.
-fn for_pairs_full(mut f: impl FnMut(usize, usize, usize, usize)) {
+/// Calls `f(c, k, k2)` for the [`PER_FACE`] pairs (component, corner, corner) of a face, in a fixed order.
+fn for_pairs_full(mut f: impl FnMut(usize, usize, usize)) {
     for c in 0..2 {
         for k in 0..3 {
-            for c2 in 0..2 {
-                for k2 in 0..3 {
-                    f(c, k, c2, k2);
-                }
+            for k2 in 0..3 {
+                f(c, k, k2);
             }
         }
     }
 }
 
-/// Calls `f(i, j)` with the unknowns of the 36 pairs of [`for_pairs_full`], same order.
+/// Calls `f(i, j)` with the unknowns of the pairs of [`for_pairs_full`], same order.
 fn for_pairs(el: &Element, mut f: impl FnMut(usize, usize)) {
-    for_pairs_full(|c, k, c2, k2| f(el.x[c][k], el.x[c2][k2]));
+    for_pairs_full(|c, k, k2| f(el.x[c][k], el.x[c][k2]));
 }
 
 #[cfg(test)]
@@ -578,7 +558,11 @@ mod tests {
             ([[0.0, -1.5], [0.4, 0.1]], 0.5, 1.0),
         ] {
             let psi = Density { mu, eps };
-            let (m, r) = psi.proxy(j).unwrap();
+            let (m, r, w_max) = psi.proxy(j).unwrap();
+            // M <= w_max I, with equality along the first eigenvector.
+            let tr = m[0][0] + m[1][1];
+            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+            assert!((w_max - 0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())).abs() < 1e-9 * w_max);
             let num = numeric_gradient(j, &psi);
             for a in 0..2 {
                 for b in 0..2 {

@@ -14,11 +14,22 @@ use super::metrics;
 use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
-use crate::linalg::{Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
+use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector, SolveError, SolverOptions, Triplet};
 use crate::mesh::{TriMesh, UnionFind};
 
 /// Repair rounds tried without lowering the number of folds before giving up.
 const REPAIR_PATIENCE: usize = 16;
+
+/// Relative residual of the Poisson solve (23).
+const POISSON_TOLERANCE: f64 = 1e-12;
+
+/// Relative residual of an ARAP global step: a local/global iteration is
+/// itself approximate, and the first solve with the factor usually reaches
+/// this (one solve instead of two with refinement to 1e-12).
+const ARAP_TOLERANCE: f64 = 1e-5;
+
+/// `max |C x| / max |x|` every solve is projected down to.
+const CONSTRAINT_TOLERANCE: f64 = 1e-14;
 
 /// Result of [`solve`]: UV per wedge.
 #[derive(Clone, Debug)]
@@ -58,6 +69,7 @@ struct System {
     /// The factorization; released (`None`) before the injective refinement,
     /// which factors a system of its own.
     solver: Option<LdltSolver>,
+    projector: NullSpaceProjector,
 }
 
 impl System {
@@ -86,8 +98,10 @@ impl System {
         self.solver.as_ref().ok_or(ParamError::Solve(SolveError::NotFactorized))
     }
 
-    /// Global step: solves (23) for the target rotations `r` (rows in the face frame).
-    fn solve(&self, weights: &[f64], r: &[[[f64; 2]; 2]]) -> Result<Vec<[f64; 2]>, ParamError> {
+    /// Global step: solves (23) for the target rotations `r` (rows in the
+    /// face frame) to the relative residual `tolerance`, then projects onto
+    /// the constraints (to [`CONSTRAINT_TOLERANCE`] of the largest unknown).
+    fn solve(&self, weights: &[f64], r: &[[[f64; 2]; 2]], tolerance: f64) -> Result<Vec<[f64; 2]>, ParamError> {
         let mut rhs = vec![0.0; self.n_unknowns + self.n_rows];
         for ((el, &wt), rf) in self.elements.iter().zip(weights).zip(r) {
             for k in 0..3 {
@@ -97,21 +111,24 @@ impl System {
                 }
             }
         }
-        let x = self.solver()?.solve(&rhs)?;
+        let mut x = self.solver()?.solve_many_to(&rhs, 1, tolerance)?.0;
+        // Redundant (consistent) rows only slow the refinement down through
+        // the multipliers; the constraints themselves must hold exactly. An
+        // inexact solve of a badly conditioned system (large repair weights)
+        // can be off them: then it is refined to full accuracy first.
+        let scale = |x: &[f64]| x[..self.n_unknowns].iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        if tolerance > POISSON_TOLERANCE && self.constraint_residual(&x) > 1e-7 * scale(&x) {
+            x = self.solver()?.solve_many_to(&rhs, 1, POISSON_TOLERANCE)?.0;
+        }
         if x.iter().any(|v| !v.is_finite()) {
             return Err(ParamError::NotFinite { what: "global solve" });
         }
-        // Redundant (consistent) rows only slow the refinement down through
-        // the multipliers; the constraints themselves must hold exactly.
-        let mut res = vec![0.0f64; self.n_rows];
-        for &(row, col, v) in &self.constraints {
-            res[row] += v * x[col];
-        }
-        let scale = x[..self.n_unknowns].iter().fold(1.0f64, |m, v| m.max(v.abs()));
-        let worst = res.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let (worst, scale) = (self.constraint_residual(&x), scale(&x));
         if worst > 1e-7 * scale {
             return Err(ParamError::ConstraintViolation { residual: worst / scale });
         }
+        // An inexact solve is off the constraints by about its residual: project back.
+        self.projector.project(&mut x[..self.n_unknowns], CONSTRAINT_TOLERANCE, 3);
         Ok((0..self.n_wedges).map(|w| [x[self.vars[0][w]], x[self.vars[1][w]]]).collect())
     }
 
@@ -280,12 +297,13 @@ pub fn solve(
         SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..SolverOptions::default() },
     )?;
     solver.factorize(&kkt.values)?;
-    let sys = System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver: Some(solver) };
+    let projector = NullSpaceProjector::new(&constraints, n_unknowns, n_rows)?;
+    let sys = System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver: Some(solver), projector };
     let mut sys = sys;
 
     // Poisson (23) with the field's target Jacobians (B.1).
     let mut r: Vec<[[f64; 2]; 2]> = (0..nf).map(|f| field.target(f)).collect();
-    let mut uv = sys.solve(&weights, &r)?;
+    let mut uv = sys.solve(&weights, &r, POISSON_TOLERANCE)?;
     let poisson_uv = uv.clone();
     timings.poisson = clock.lap();
 
@@ -452,7 +470,7 @@ fn arap(
             }
         }
         // Global step: (23) with the new R, same factorization.
-        *uv = sys.solve(weights, r)?;
+        *uv = sys.solve(weights, r, ARAP_TOLERANCE)?;
         prev = prev.min(e);
         e = energy(r, uv);
         if prev.is_finite() && (prev - e) <= options.arap_tolerance * prev.max(f64::MIN_POSITIVE) {
