@@ -406,7 +406,7 @@ impl<'a> VertexLocator<'a> {
                     for &v in self.grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]).into_iter().flatten() {
                         let q = self.positions[v as usize];
                         let d = ((0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>()).sqrt();
-                        if d <= self.tolerance && best.map_or(true, |(bd, _)| d < bd) {
+                        if d <= self.tolerance && best.is_none_or(|(bd, _)| d < bd) {
                             best = Some((d, v));
                         }
                     }

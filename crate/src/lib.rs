@@ -6,6 +6,10 @@
 //! file bytes → [`io`] (a [`RawMesh`]) → [`mesh`] (a validated [`TriMesh`])
 //! → discrete operators → cone placement → cut and field → parametrization → export.
 
+// `!(x > 0.0)` is how this crate rejects NaN along with non-positive values;
+// index loops read like the formulas they implement.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
 pub mod clock;
 pub mod cones;
 pub mod export;

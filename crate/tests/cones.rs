@@ -1,6 +1,7 @@
 //! Cone placement on the shared test meshes: Gauss-Bonnet per component,
 //! exact constraints, and the alpha_smooth trade-off (fewer cones, larger
 //! phi as alpha grows).
+#![allow(clippy::needless_range_loop)] // tables and index loops mirror the README / formulas
 
 use conemap::cones::{place_cones, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;

@@ -16,6 +16,7 @@
 //! gives V = 2904, χ = 2: a genus-0 closed surface. `analyze` reports
 //! `NonManifoldVertex { vertex: 253, fans: 2 }`; `TriMesh::from_raw` splits it
 //! (one vertex per fan) and keeps the problem in its report.
+#![allow(clippy::type_complexity)] // tables and index loops mirror the README / formulas
 
 use conemap::io::import_path;
 use conemap::mesh::{analyze, analyze_by_index, MeshReport, TriMesh};

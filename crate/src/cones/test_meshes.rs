@@ -86,7 +86,7 @@ pub fn square_annulus(n: usize, rings: usize, inner: f64, angle: f64) -> TriMesh
 pub fn ring_with_flap(n: usize) -> TriMesh {
     use std::collections::HashMap;
     use std::f64::consts::PI;
-    assert!(n % 4 == 0);
+    assert!(n.is_multiple_of(4));
     let (quarter, half) = (n / 4, n / 2);
     let theta = |i: usize| 2.0 * PI * i as f64 / n as f64;
     let outer = |i: usize| if i <= quarter { 1.5 + 0.5 * theta(i).sin() } else { 2.0 };

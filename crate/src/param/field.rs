@@ -77,9 +77,8 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
     let mut seed: Vec<Option<u32>> = vec![None; n_comp];
     for h in 0..3 * nf as u32 {
         let c = comps[(h / 3) as usize] as usize;
-        if cm.is_boundary_halfedge(cm.twin(h)) && seed[c].map_or(true, |s| !cm.is_boundary_halfedge(cm.twin(s))) {
-            seed[c] = Some(h);
-        } else if seed[c].is_none() {
+        let on_boundary = |s: u32| cm.is_boundary_halfedge(cm.twin(s));
+        if seed[c].is_none_or(|s| on_boundary(h) && !on_boundary(s)) {
             seed[c] = Some(h);
         }
     }
