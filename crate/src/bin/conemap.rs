@@ -10,6 +10,27 @@ use conemap::mesh::{analyze, MeshReport, TriMesh};
 use std::path::Path;
 use std::process::ExitCode;
 
+/// `println!` that ends the program quietly when standard output is closed
+/// (piped into `head`, say) instead of panicking.
+macro_rules! println {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
+            stdout_failed(e)
+        }
+    }};
+}
+
+/// Exits after a failed write to standard output: silently (status 0) when
+/// the reader went away, else with the error on standard error (status 1).
+fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("conemap: cannot write to standard output: {e}");
+    std::process::exit(1);
+}
+
 const USAGE: &str = "\
 usage: conemap <command> [options]
 
