@@ -1,7 +1,7 @@
 // Messages between the page and the wasm worker. Every request carries an id;
 // the worker answers with any number of `progress` messages, then exactly one
 // `result` or `error` with the same id. The worker keeps one `MeshSession`
-// (the last mesh opened); later requests (`sharp`, `solve`) refer to it.
+// (the last mesh opened); later requests (`sharp`, `solve-*`) refer to it.
 
 /** One input file: the mesh first, companion files (.bin, textures) after it. */
 export interface WireFile {
@@ -20,13 +20,6 @@ export type Request =
       simulateTrap?: boolean;
     }
   | { id: number; type: 'sharp'; degrees: number }
-  | {
-      id: number;
-      type: 'solve';
-      features: Uint32Array;
-      alphaSmooth: number;
-      miq: boolean;
-    }
   // A solve in steps (so that a helper worker can place some components):
   // begin → place every component (here, or in a helper and then add) → finish.
   | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean }
@@ -76,7 +69,7 @@ export interface ImportResult {
   faceEdges: Uint32Array;
   /** Vertex adjacency in CSR form (see topology.ts), for shortest edge paths. */
   adjacency: { offsets: Uint32Array; nbr: Uint32Array; eid: Uint32Array } | null;
-  /** The wasm build has `MeshSession.solve` (UVs); otherwise only cone placement. */
+  /** The wasm build can parametrize (`MeshSession.solve_begin` and the other steps). */
   canSolve: boolean;
   /** Milliseconds spent in the wasm import and in the edge extraction. */
   timings: { import: number; edges: number };

@@ -18,8 +18,8 @@ let ready: Promise<unknown> | null = null;
 const wasmReady = (): Promise<unknown> =>
   (ready ??= init({ module_or_path: new URL('./pkg/conemap_bg.wasm', import.meta.url) }));
 
-/** The session API as the page uses it; `solve` only exists in newer builds. */
 type Progress = (stage: string, step: number, remaining: number) => void;
+/** The session API as the page uses it. */
 interface Session {
   report(): MeshReport;
   is_valid(): boolean;
@@ -28,8 +28,6 @@ interface Session {
   edges(): Uint32Array;
   boundary_edges(): Uint32Array;
   sharp_edges(degrees: number): Uint32Array;
-  place_cones(features: Uint32Array, alpha: number, miq: boolean, progress: Progress): Omit<SolveResult, 'elapsed'>;
-  solve?: (features: Uint32Array, alpha: number, miq: boolean, progress: Progress) => unknown;
   solve_begin(features: Uint32Array, alpha: number, miq: boolean): Uint32Array;
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
   solve_add(bytes: Uint8Array): void;
@@ -37,6 +35,9 @@ interface Session {
   free(): void;
 }
 let session: Session | null = null;
+
+/** A request's result and the buffers to transfer with it. */
+type Answer = { value: unknown; transfer: Transferable[] };
 
 function post(message: Response, transfer: Transferable[] = []): void {
   scope.postMessage(message, transfer);
@@ -88,7 +89,7 @@ function openMesh(req: Extract<Request, { type: 'import' }>): Answer {
     boundary,
     faceEdges: faceEdgeIds,
     adjacency,
-    canSolve: typeof next.solve === 'function',
+    canSolve: typeof next.solve_begin === 'function',
     timings: { import: t1 - t0, edges: t2 - t1 },
     version: version(),
   };
@@ -112,18 +113,6 @@ function throttledProgress(id: number): Progress {
     lastPost = now;
     post({ id, type: 'progress', stage, step, remaining });
   };
-}
-
-type Answer = { value: unknown; transfer: Transferable[] };
-
-function solve(req: Extract<Request, { type: 'solve' }>): Answer {
-  const s = requireSession();
-  const progress = throttledProgress(req.id);
-  const t0 = performance.now();
-  post({ id: req.id, type: 'progress', stage: 'starting', step: 0, remaining: 0 });
-  if (typeof s.solve === 'function') return solveAnswer(s, s.solve(req.features, req.alphaSmooth, req.miq, progress), t0);
-  const r = s.place_cones(req.features, req.alphaSmooth, req.miq, progress);
-  return { value: { ...r, elapsed: performance.now() - t0 }, transfer: [] };
 }
 
 /** When the current stepwise solve began (`elapsed` of its result counts from there). */
@@ -231,9 +220,6 @@ async function handle(req: Request): Promise<void> {
         out = { value: { edges }, transfer: [edges.buffer] };
         break;
       }
-      case 'solve':
-        out = solve(req);
-        break;
       case 'solve-begin':
       case 'solve-place':
       case 'solve-add':
