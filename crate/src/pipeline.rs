@@ -1,7 +1,8 @@
 //! The whole method in one call: refine doubly constrained triangles, place
 //! cones (sections 4-5) — refining around any vertex that would need a cone
 //! of angle 0 and placing them again —, then compute the seamless aligned
-//! parametrization (Appendix B). The CLI and the wasm API call this.
+//! parametrization (Appendix B). The CLI calls [`solve`]; the wasm API runs
+//! the same steps ([`ConeStage`]) so that a helper worker can place components.
 
 use crate::clock::{now_seconds, Stopwatch};
 use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
@@ -192,9 +193,9 @@ impl ConeStage {
 
     /// Joins the placed components (one per component of
     /// [`Self::problem`]); refines around cones of angle 0 while attempts
-    /// remain. The placement's `timings.total` is the stage's wall-clock time
-    /// without the refinements (components may have run in parallel, so the
-    /// per-stage timings can add up to more).
+    /// remain. The placement's `timings.total` is the wall-clock time of all
+    /// attempts without the refinements (the per-stage timings are those of
+    /// the last attempt, summed over components that may have run in parallel).
     pub fn finish(self, mesh: &TriMesh, features: &FeatureSet, results: Vec<ComponentPlacement>) -> Result<ConeStep, SolveError> {
         let ConeStage { options, refined, attempt, mut refine_seconds, started, problem } = self;
         let m = refined.as_ref().map_or(mesh, |r| &r.mesh);

@@ -157,12 +157,10 @@ export class Editor {
     this.el.status.hidden = true;
     if (features) this.viewer.setLines('boundary', edges, data.boundary, COLORS.boundary, 3, 0);
     this.redrawFeatures();
-    this.el.note.hidden = data.canSolve;
-    this.el.note.textContent = data.canSolve ? '' : 'Parametrization not available in this build: Run places the cones only; UV views are disabled.';
-    if (!data.valid) {
-      this.el.note.hidden = false;
-      this.el.note.textContent = 'This mesh has blocking problems (see below): features cannot be marked and Run will report why it cannot be parametrized.';
-    }
+    this.el.note.hidden = data.valid;
+    this.el.note.textContent = data.valid
+      ? ''
+      : 'This mesh has blocking problems (see below): features cannot be marked and Run will report why it cannot be parametrized.';
     this.updateFeatureUi();
   }
 

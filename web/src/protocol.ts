@@ -69,8 +69,6 @@ export interface ImportResult {
   faceEdges: Uint32Array;
   /** Vertex adjacency in CSR form (see topology.ts), for shortest edge paths. */
   adjacency: { offsets: Uint32Array; nbr: Uint32Array; eid: Uint32Array } | null;
-  /** The wasm build can parametrize (`MeshSession.solve_begin` and the other steps). */
-  canSolve: boolean;
   /** Milliseconds spent in the wasm import and in the edge extraction. */
   timings: { import: number; edges: number };
   version: string;
@@ -109,7 +107,7 @@ export interface SolveMetrics {
   [key: string]: unknown;
 }
 
-/** Cone placement result (`place_cones`), plus the UV part when the build can `solve`. */
+/** The result of a solve: cones (as `place_cones` reports them), UVs, metrics and exports. */
 export interface SolveResult {
   cones: Cone[];
   boundary_corners: Cone[];
@@ -119,7 +117,7 @@ export interface SolveResult {
   phi_rms: number;
   timings: Record<string, number>;
   feature_edges: number;
-  /** Milliseconds in the worker for the whole request. */
+  /** Milliseconds in the main worker from `solve-begin` to the end of `solve-finish`. */
   elapsed: number;
   uv?: Float32Array;
   seam_edges?: Uint32Array;

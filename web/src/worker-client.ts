@@ -167,33 +167,55 @@ export class MeshWorker {
    * worker (and from the helper once this one has nothing left to place).
    */
   async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn): Promise<SolveResult> {
+    const generation = this.restarts;
+    /** Throws `Cancelled` once this worker was replaced (cancel or crash) since the solve began. */
+    const alive = (): void => {
+      if (this.restarts !== generation) throw new Cancelled('cancelled');
+    };
     const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq }, [], onProgress);
     const queue = Array.from(schedule);
+    const total = schedule.length;
     const helper = this.startHelper(features, alphaSmooth, miq, schedule);
     let ownDone = false;
+    let helperBusy = false;
+    let placed = 0;
     let helped = 0;
     const leftover: number[] = [];
-    // Every request opens with a 'starting' report: not news in the middle of a solve.
-    const placing: ProgressFn = (stage, ...rest) => stage !== 'starting' && onProgress(stage, ...rest);
+    // Every request opens with a 'starting' report: not news in the middle of
+    // a solve. Components go largest first, to two workers: 'topology'
+    // reports count the components placed so far rather than naming one.
+    const placing: ProgressFn = (stage, step, remaining) => {
+      if (stage === 'starting') return;
+      if (stage === 'topology') onProgress(stage, Math.min(placed, total - 1), total);
+      else onProgress(stage, step, remaining);
+    };
     const own = async (): Promise<void> => {
       if (helper && MeshWorker.helperWait) await helper.ready.catch(() => {});
+      alive();
       for (let c = queue.shift(); c !== undefined; c = queue.shift()) {
         await this.send({ type: 'solve-place', component: c, share: false }, [], placing);
+        placed++;
       }
       ownDone = true;
+      // A helper still starting up would only make the solve wait for it.
+      if (helper && !helperBusy && this.helper === helper.worker) this.dropHelper();
     };
     const help = async (h: Helper): Promise<void> => {
       const progress: ProgressFn = (...a) => ownDone && placing(...a);
       try {
         await h.ready;
         for (let c = queue.shift(); c !== undefined; c = queue.shift()) {
+          helperBusy = true;
           try {
             const { bytes } = await h.worker.send<{ bytes: Uint8Array }>({ type: 'solve-place', component: c, share: true }, [], progress);
             await this.send({ type: 'solve-add', bytes }, [bytes.buffer]);
             helped++;
+            placed++;
           } catch (e) {
             leftover.push(c);
             throw e;
+          } finally {
+            helperBusy = false;
           }
         }
       } catch (e) {
@@ -206,7 +228,11 @@ export class MeshWorker {
     };
     try {
       await Promise.all([own(), helper ? help(helper) : null]);
-      for (const c of leftover) await this.send({ type: 'solve-place', component: c, share: false }, [], placing);
+      for (const c of leftover) {
+        alive();
+        await this.send({ type: 'solve-place', component: c, share: false }, [], placing);
+      }
+      alive();
       const result = await this.send<SolveResult>({ type: 'solve-finish' }, [], placing);
       return { ...result, helperComponents: helped };
     } finally {

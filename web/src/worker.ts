@@ -89,7 +89,6 @@ function openMesh(req: Extract<Request, { type: 'import' }>): Answer {
     boundary,
     faceEdges: faceEdgeIds,
     adjacency,
-    canSolve: typeof next.solve_begin === 'function',
     timings: { import: t1 - t0, edges: t2 - t1 },
     version: version(),
   };

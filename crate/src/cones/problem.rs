@@ -52,8 +52,9 @@ pub struct ComponentPlacement {
     pub moves_seconds: f64,
 }
 
-/// A set of component placements that does not fit the problem (results
-/// from another instance that solved a different mesh or feature set).
+/// Component placements that do not fit the problem: a component missing or
+/// twice, indices out of range, faces of another component, lengths that
+/// disagree (e.g. results from an instance that opened another mesh).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MismatchError(pub String);
 
@@ -194,6 +195,8 @@ impl ConeProblem {
     /// Joins one placement per component (any order) into the placement of
     /// `mesh` (the mesh this problem was built from). Checks that the results
     /// fit: every component exactly once, indices in range, lengths matching.
+    /// `timings.total` is the sum of the stages; a caller that knows the
+    /// wall-clock time (components may run in parallel) overwrites it.
     pub fn assemble(self, mesh: &TriMesh, mut results: Vec<ComponentPlacement>) -> Result<ConePlacement, MismatchError> {
         let cm = &self.cut.mesh;
         let (nv, nf) = (cm.n_vertices(), cm.n_faces());

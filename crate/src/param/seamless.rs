@@ -69,7 +69,9 @@ struct System {
     /// The factorization; released (`None`) before the injective refinement,
     /// which factors a system of its own.
     solver: Option<LdltSolver>,
-    projector: NullSpaceProjector,
+    /// Puts inexact solves back onto the constraints; `None` when `C Cᵀ`
+    /// could not be factored (every solve is then refined to full accuracy).
+    projector: Option<NullSpaceProjector>,
 }
 
 impl System {
@@ -111,11 +113,11 @@ impl System {
                 }
             }
         }
+        let tolerance = if self.projector.is_some() { tolerance } else { POISSON_TOLERANCE };
         let mut x = self.solver()?.solve_many_to(&rhs, 1, tolerance)?.0;
-        // Redundant (consistent) rows only slow the refinement down through
-        // the multipliers; the constraints themselves must hold exactly. An
-        // inexact solve of a badly conditioned system (large repair weights)
-        // can be off them: then it is refined to full accuracy first.
+        // The constraints must hold exactly. An inexact solve of a badly
+        // conditioned system (large repair weights) can be far off them:
+        // then it is refined to full accuracy first.
         let scale = |x: &[f64]| x[..self.n_unknowns].iter().fold(1.0f64, |m, v| m.max(v.abs()));
         if tolerance > POISSON_TOLERANCE && self.constraint_residual(&x) > 1e-7 * scale(&x) {
             x = self.solver()?.solve_many_to(&rhs, 1, POISSON_TOLERANCE)?.0;
@@ -128,7 +130,9 @@ impl System {
             return Err(ParamError::ConstraintViolation { residual: worst / scale });
         }
         // An inexact solve is off the constraints by about its residual: project back.
-        self.projector.project(&mut x[..self.n_unknowns], CONSTRAINT_TOLERANCE, 3);
+        if let Some(projector) = &self.projector {
+            projector.project(&mut x[..self.n_unknowns], CONSTRAINT_TOLERANCE, 3);
+        }
         Ok((0..self.n_wedges).map(|w| [x[self.vars[0][w]], x[self.vars[1][w]]]).collect())
     }
 
@@ -297,7 +301,7 @@ pub fn solve(
         SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..SolverOptions::default() },
     )?;
     solver.factorize(&kkt.values)?;
-    let projector = NullSpaceProjector::new(&constraints, n_unknowns, n_rows)?;
+    let projector = NullSpaceProjector::new(&constraints, n_unknowns, n_rows).ok();
     let sys = System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver: Some(solver), projector };
     let mut sys = sys;
 
