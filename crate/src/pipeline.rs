@@ -116,13 +116,11 @@ pub fn solve<'a>(
     options: &SolveOptions,
     progress: &mut dyn FnMut(SolveProgress),
 ) -> Result<Solution<'a>, SolveError> {
-    let mut stage = ConeStage::new(mesh, features, options);
-    let placed = loop {
-        let results = cones::place_all(stage.problem(), &mut |p| progress(SolveProgress::Cones(p))).map_err(SolveError::Cones)?;
-        match stage.finish(mesh, features, results)? {
-            ConeStep::Placed(placed) => break placed,
-            ConeStep::Again(next) => stage = next,
-        }
+    let placed = {
+        let mut cone_progress = |p| progress(SolveProgress::Cones(p));
+        let stage = ConeStage::new(mesh, features, options);
+        let results = cones::place_all(stage.problem(), &mut cone_progress).map_err(SolveError::Cones)?;
+        stage.complete(mesh, features, results, &mut cone_progress)?
     };
     placed.parametrize(mesh, features, &mut |p| progress(SolveProgress::Param(p)))
 }
@@ -130,7 +128,7 @@ pub fn solve<'a>(
 /// The cone stage of [`solve`] as steps, so that its components can be
 /// placed anywhere (threads, other wasm instances that built the same
 /// stage): build it, place every component of [`ConeStage::problem`], then
-/// [`ConeStage::finish`]. Every method takes the same `mesh` and `features`.
+/// [`ConeStage::complete`]. Every method takes the same `mesh` and `features`.
 #[derive(Clone, Debug)]
 pub struct ConeStage {
     options: SolveOptions,
@@ -146,7 +144,7 @@ pub struct ConeStage {
 
 /// What [`ConeStage::finish`] leads to.
 #[derive(Clone, Debug)]
-pub enum ConeStep {
+enum ConeStep {
     /// The cones are placed: go on to the parametrization.
     Placed(Placed),
     /// Cones of angle 0 appeared: the mesh was refined around them; place
@@ -191,12 +189,34 @@ impl ConeStage {
         &self.problem
     }
 
-    /// Joins the placed components (one per component of
-    /// [`Self::problem`]); refines around cones of angle 0 while attempts
-    /// remain. The placement's `timings.total` is the wall-clock time of all
+    /// Joins the placed components (one per component of [`Self::problem`])
+    /// into the placement. Where cones of angle 0 appear, the mesh is refined
+    /// around them and the refined stage's components are placed here
+    /// ([`cones::place_all`], reporting to `progress`), while attempts remain.
+    pub fn complete(
+        self,
+        mesh: &TriMesh,
+        features: &FeatureSet,
+        results: Vec<ComponentPlacement>,
+        progress: &mut dyn FnMut(cones::Progress),
+    ) -> Result<Placed, SolveError> {
+        let (mut stage, mut results) = (self, results);
+        loop {
+            match stage.finish(mesh, features, results)? {
+                ConeStep::Placed(placed) => return Ok(placed),
+                ConeStep::Again(next) => {
+                    results = cones::place_all(next.problem(), progress).map_err(SolveError::Cones)?;
+                    stage = next;
+                }
+            }
+        }
+    }
+
+    /// One step of [`Self::complete`]: joins the placed components, or
+    /// refines around cones of angle 0 while attempts remain. The placement's `timings.total` is the wall-clock time of all
     /// attempts without the refinements (the per-stage timings are those of
     /// the last attempt, summed over components that may have run in parallel).
-    pub fn finish(self, mesh: &TriMesh, features: &FeatureSet, results: Vec<ComponentPlacement>) -> Result<ConeStep, SolveError> {
+    fn finish(self, mesh: &TriMesh, features: &FeatureSet, results: Vec<ComponentPlacement>) -> Result<ConeStep, SolveError> {
         let ConeStage { options, refined, attempt, mut refine_seconds, started, problem } = self;
         let m = refined.as_ref().map_or(mesh, |r| &r.mesh);
         let mut placement = problem.assemble(m, results).map_err(SolveError::Components)?;

@@ -5,7 +5,7 @@
 use crate::cones::{self, ComponentPlacement, ConeOptions, ConePlacement, Progress};
 use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::{self, ParamOptions, ParamProgress};
-use crate::pipeline::{ConeStage, ConeStep, Solution, SolveError, SolveOptions};
+use crate::pipeline::{ConeStage, Solution, SolveError, SolveOptions};
 use crate::features::FeatureSet;
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -203,18 +203,10 @@ impl MeshSession {
     /// refinement around cones of angle 0 is placed here); returns what
     /// `solve` returns. Ends the started solve.
     pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsError> {
-        let Job { features, mut stage, mut placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
+        let Job { features, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
         let mesh = self.valid_mesh()?;
         let fail = |e: SolveError| JsError::new(&e.to_string());
-        let placed = loop {
-            match stage.finish(mesh, &features, std::mem::take(&mut placed)).map_err(fail)? {
-                ConeStep::Placed(p) => break p,
-                ConeStep::Again(next) => stage = next,
-            }
-            for c in stage.problem().schedule() {
-                placed.push(stage.problem().place_component(c, &mut cone_progress(progress)).map_err(|e| JsError::new(&e.to_string()))?);
-            }
-        };
+        let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
         let mut report = |p: ParamProgress| {
             let (stage, a, b) = match p {
                 ParamProgress::Field => ("cross-field", 0, 0),
