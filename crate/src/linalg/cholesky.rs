@@ -62,28 +62,16 @@ pub struct SolveInfo {
     pub refinement_steps: usize,
 }
 
-/// How the symbolic analysis picks between faer's simplicial and
-/// supernodal (dense-front) numeric factorizations.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Fronts {
-    /// faer's choice by flop density natively; simplicial on wasm32, whose
-    /// dense kernels run without SIMD: measured on the fandisk subdivided
-    /// to 207 k faces, the cone KKTs and the ARAP system factor and solve
-    /// 10-60 % faster there without fronts.
-    #[default]
-    Auto,
-    /// faer's choice on every target, for systems dense enough that fronts
-    /// win even with scalar kernels (the u-v coupled system of the injective
-    /// refinement: 40 s without fronts against 28 s with them in wasm).
-    Dense,
-}
-
-impl Fronts {
-    fn threshold(self) -> SupernodalThreshold {
-        match self {
-            Fronts::Auto if cfg!(target_arch = "wasm32") => SupernodalThreshold::FORCE_SIMPLICIAL,
-            _ => SupernodalThreshold::AUTO,
-        }
+/// Which numeric factorization faer's symbolic analysis may pick: its own
+/// choice by flop density natively; simplicial on wasm32, whose dense
+/// (supernodal) kernels run without SIMD. Measured on the fandisk subdivided
+/// to 207 k faces, the cone KKTs and the parametrization systems factor and
+/// solve 10-60 % faster there without dense fronts.
+fn supernodal_threshold() -> SupernodalThreshold {
+    if cfg!(target_arch = "wasm32") {
+        SupernodalThreshold::FORCE_SIMPLICIAL
+    } else {
+        SupernodalThreshold::AUTO
     }
 }
 
@@ -133,7 +121,7 @@ fn norm2(v: &[f64]) -> f64 {
 }
 
 impl Core {
-    fn new(kind: Kind, pattern: &SymmetricPattern, signs: Vec<i8>, fronts: Fronts) -> Result<Self, SolveError> {
+    fn new(kind: Kind, pattern: &SymmetricPattern, signs: Vec<i8>) -> Result<Self, SolveError> {
         let n = pattern.dim();
         let sym = SymbolicSparseColMatRef::new_checked(
             n,
@@ -146,7 +134,7 @@ impl Core {
             sym,
             Side::Upper,
             SymmetricOrdering::Amd,
-            CholeskySymbolicParams { supernodal_flop_ratio_threshold: fronts.threshold(), ..CholeskySymbolicParams::default() },
+            CholeskySymbolicParams { supernodal_flop_ratio_threshold: supernodal_threshold(), ..CholeskySymbolicParams::default() },
         )
         .map_err(faer_err)?;
         let factor_req = match kind {
@@ -378,11 +366,6 @@ impl SparseCholesky<Ldlt> {
     /// of row `i`: `+1` for primal rows, `−1` for constraint rows (`0`: only
     /// regularize pivots below `epsilon` in magnitude). Errors on bad lengths/signs.
     pub fn new(pattern: &SymmetricPattern, signs: &[i8]) -> Result<Self, SolveError> {
-        Self::with_fronts(pattern, signs, Fronts::Auto)
-    }
-
-    /// [`Self::new`] with an explicit [`Fronts`] choice.
-    pub fn with_fronts(pattern: &SymmetricPattern, signs: &[i8], fronts: Fronts) -> Result<Self, SolveError> {
         if signs.len() != pattern.dim() {
             return Err(SolveError::DimensionMismatch {
                 what: "signs",
@@ -393,7 +376,7 @@ impl SparseCholesky<Ldlt> {
         if let Some((index, &sign)) = signs.iter().enumerate().find(|(_, s)| !(-1..=1).contains(*s)) {
             return Err(SolveError::InvalidSign { index, sign });
         }
-        Ok(Self { core: Core::new(Kind::Ldlt, pattern, signs.to_vec(), fronts)?, kind: PhantomData })
+        Ok(Self { core: Core::new(Kind::Ldlt, pattern, signs.to_vec())?, kind: PhantomData })
     }
 
     /// Like [`Self::new`] with non-default [`SolverOptions`].
@@ -417,7 +400,7 @@ impl SparseCholesky<Llt> {
     /// Symbolic analysis (AMD ordering) for `pattern`.
     pub fn new(pattern: &SymmetricPattern) -> Result<Self, SolveError> {
         let n = pattern.dim();
-        Ok(Self { core: Core::new(Kind::Llt, pattern, vec![1; n], Fronts::Auto)?, kind: PhantomData })
+        Ok(Self { core: Core::new(Kind::Llt, pattern, vec![1; n])?, kind: PhantomData })
     }
 
     /// Builds the pattern from `triplets` (upper or full), analyses and factorizes.

@@ -128,6 +128,15 @@ pub fn solve_kkt(
     Ok(KktSolution { x, lambda, info })
 }
 
+/// `C y` per row for the constraint triplets `c` (`(row, unknown, value)`, rows `0..m`).
+pub fn constraint_values(c: &[Triplet], m: usize, y: &[f64]) -> Vec<f64> {
+    let mut res = vec![0.0f64; m];
+    for &(row, col, v) in c {
+        res[row] += v * y[col];
+    }
+    res
+}
+
 /// Orthogonal projection onto the null space of a full-row-rank constraint
 /// matrix `C` (m × n): `y -> y - Cᵀ (C Cᵀ)⁻¹ C y`, with `C Cᵀ` factored once.
 /// Cheap next to a KKT solve (`C Cᵀ` couples only rows sharing an unknown),
@@ -161,11 +170,7 @@ impl NullSpaceProjector {
 
     /// `C y` per row.
     pub fn residual(&self, y: &[f64]) -> Vec<f64> {
-        let mut res = vec![0.0f64; self.m];
-        for &(row, col, v) in &self.c {
-            res[row] += v * y[col];
-        }
-        res
+        constraint_values(&self.c, self.m, y)
     }
 
     /// Projects `y` (length `n`) onto `C y = 0` in place, repeating (at most

@@ -24,8 +24,8 @@ mod pattern;
 mod tests;
 
 pub use bordered::FixBorder;
-pub use cholesky::{Fronts, Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
-pub use kkt::{solve_kkt, Kkt, KktSolution, NullSpaceProjector};
+pub use cholesky::{Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
+pub use kkt::{constraint_values, solve_kkt, Kkt, KktSolution, NullSpaceProjector};
 pub use pattern::{SymmetricPattern, Triplet, IGNORED_SLOT};
 
 use std::fmt;

@@ -230,13 +230,20 @@ pub(super) struct Refiner<'a> {
     values: Vec<f64>,
     /// Puts every step back onto `C d = 0` (the factor's solve leaves it off by
     /// the regularization, ~1e-8 relative to the step).
-    projector: NullSpaceProjector,
+    projector: &'a NullSpaceProjector,
 }
 
 impl<'a> Refiner<'a> {
     /// Builds the pattern for `elements` (unknowns `0..n`) and the `m`
-    /// constraint rows `constraints` (`(row, unknown, value)`, homogeneous).
-    pub(super) fn new(elements: &'a [Element], n: usize, constraints: &'a [Triplet], m: usize) -> Result<Self, ParamError> {
+    /// constraint rows `constraints` (`(row, unknown, value)`, homogeneous),
+    /// whose null-space `projector` it borrows.
+    pub(super) fn new(
+        elements: &'a [Element],
+        n: usize,
+        constraints: &'a [Triplet],
+        m: usize,
+        projector: &'a NullSpaceProjector,
+    ) -> Result<Self, ParamError> {
         let mut a = Vec::with_capacity(PER_FACE * elements.len());
         for el in elements {
             for_pairs(el, |i, j| a.push((i, j, if i == j { 1.0 } else { 0.0 })));
@@ -251,7 +258,6 @@ impl<'a> Refiner<'a> {
         drop(t);
         let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs)?;
         solver.set_options(SolverOptions { delta: 1e-11, ..SolverOptions::default() });
-        let projector = NullSpaceProjector::new(constraints, n, m)?;
         Ok(Refiner { elements, n, constraints, kkt, solver, slots, values, projector })
     }
 
@@ -455,11 +461,7 @@ mod tests {
     }
 
     fn residual(c: &[Triplet], m: usize, x: &[f64]) -> f64 {
-        let mut r = vec![0.0f64; m];
-        for &(i, j, v) in c {
-            r[i] += v * x[j];
-        }
-        r.iter().fold(0.0f64, |a, b| a.max(b.abs()))
+        crate::linalg::constraint_values(c, m, x).iter().fold(0.0f64, |a, b| a.max(b.abs()))
     }
 
     fn min_area(elements: &[Element], x: &[f64]) -> f64 {
@@ -484,7 +486,8 @@ mod tests {
             x[nv + i] = p[1] * s;
         }
         assert!(residual(&c, m, &x) < 1e-15 && min_area(&elements, &x) > 0.0);
-        let mut refiner = Refiner::new(&elements, 2 * nv, &c, m).unwrap();
+        let projector = NullSpaceProjector::new(&c, 2 * nv, m).unwrap();
+        let mut refiner = Refiner::new(&elements, 2 * nv, &c, m, &projector).unwrap();
         let options = RefineOptions::default();
         let stats = refiner.refine(&mut x, &options, &mut |_| {});
         assert!(stats.iterations > 0 && stats.iterations <= options.max_iterations);
@@ -514,7 +517,8 @@ mod tests {
             RefineOptions { smoothing: 0.3, ..RefineOptions::default() },
         ] {
             let mut y = x.clone();
-            let mut refiner = Refiner::new(&elements, 2 * nv, &c, m).unwrap();
+            let projector = NullSpaceProjector::new(&c, 2 * nv, m).unwrap();
+            let mut refiner = Refiner::new(&elements, 2 * nv, &c, m, &projector).unwrap();
             let stats = refiner.refine(&mut y, &options, &mut |_| {});
             assert!(stats.energy < 0.5 * stats.energy_start, "{options:?}: {stats:?}");
             assert!(min_area(&elements, &y) > 0.0 && residual(&c, m, &y) < 1e-13);
@@ -527,7 +531,8 @@ mod tests {
         let nv = mesh.n_vertices();
         // The zero map (feasible, every triangle degenerate): not a valid start.
         let mut x = vec![0.0; 2 * nv];
-        let mut refiner = Refiner::new(&elements, 2 * nv, &c, m).unwrap();
+        let projector = NullSpaceProjector::new(&c, 2 * nv, m).unwrap();
+        let mut refiner = Refiner::new(&elements, 2 * nv, &c, m, &projector).unwrap();
         let stats = refiner.refine(&mut x, &RefineOptions::default(), &mut |_| {});
         assert_eq!(stats.iterations, 0);
         assert_eq!(stats.energy_start, f64::INFINITY);

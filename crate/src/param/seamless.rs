@@ -14,7 +14,7 @@ use super::metrics;
 use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
-use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector, SolveError, SolverOptions, Triplet};
+use crate::linalg::{constraint_values, Kkt, LdltSolver, NullSpaceProjector, SolveError, SolverOptions, Triplet};
 use crate::mesh::{TriMesh, UnionFind};
 
 /// Repair rounds tried without lowering the number of folds before giving up.
@@ -161,11 +161,7 @@ impl System {
 
     /// Largest `|C x|` over the constraint rows (all homogeneous).
     fn constraint_residual(&self, x: &[f64]) -> f64 {
-        let mut res = vec![0.0f64; self.n_rows];
-        for &(row, col, v) in &self.constraints {
-            res[row] += v * x[col];
-        }
-        res.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        constraint_values(&self.constraints, self.n_rows, x).iter().fold(0.0f64, |m, v| m.max(v.abs()))
     }
 
     fn jacobian(&self, f: usize, uv: &[[f64; 2]]) -> [[f64; 2]; 2] {
@@ -423,7 +419,8 @@ pub fn solve(
 /// unknowns `start`; `None` when it made no progress, failed numerically or
 /// drifted off the constraints (then `start` stands).
 fn refine(sys: &System, start: &[f64], options: &RefineOptions, progress: &mut dyn FnMut(ParamProgress)) -> Option<(Vec<f64>, usize)> {
-    let mut refiner = Refiner::new(&sys.elements, sys.n_unknowns, &sys.constraints, sys.n_rows).ok()?;
+    let projector = sys.projector.as_ref()?;
+    let mut refiner = Refiner::new(&sys.elements, sys.n_unknowns, &sys.constraints, sys.n_rows, projector).ok()?;
     let mut x = start.to_vec();
     let max = options.max_iterations;
     let stats = refiner.refine(&mut x, options, &mut |iteration| progress(ParamProgress::Injective { iteration: iteration + 1, max }));
