@@ -6,7 +6,7 @@
 
 use crate::clock::{now_seconds, Stopwatch};
 use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
-use crate::features::{split_around, split_doubly_constrained, FeatureSet, Refined};
+use crate::features::{refine_for_features, split_around, FeatureSet, RefineCounts, Refined};
 use crate::mesh::TriMesh;
 use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrization};
 use std::borrow::Cow;
@@ -55,17 +55,81 @@ pub struct Solution<'a> {
     pub features: Cow<'a, FeatureSet>,
     /// Edges split before solving (0: `mesh` is the input).
     pub splits: usize,
-    /// When split: solved face → input face and solved vertex → input
-    /// vertex (`NONE` for inserted midpoints).
+    /// When split: solved face → input face, solved vertex → input
+    /// vertex (`NONE` for inserted vertices) and solved edge → the input
+    /// edge it is a piece of (`NONE` for edges inside input faces).
     pub original_face: Option<Vec<u32>>,
     pub original_vertex: Option<Vec<u32>>,
+    pub original_edge: Option<Vec<u32>>,
+    /// What the refinement split, by reason.
+    pub refinement: RefineCounts,
     pub placement: ConePlacement,
     pub param: Parametrization,
     /// Seconds spent refining.
     pub refine_seconds: f64,
 }
 
+/// Largest angle (radians) between a feature edge's UV image and an axis
+/// for the edge to count as aligned: solver round-off is about 1e-13 here.
+pub const ALIGNED_TOLERANCE: f64 = 1e-9;
+
+/// How the requested feature edges came out ([`Solution::feature_alignment`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FeatureAlignment {
+    /// Feature edges requested (input edges).
+    pub requested: usize,
+    /// Of those, the edges whose UV image on every side (every piece, where
+    /// the refinement split the edge) is parallel to an axis within [`ALIGNED_TOLERANCE`].
+    pub aligned: usize,
+    /// Largest deviation from an axis over all requested edges, radians.
+    pub worst_radians: f64,
+    /// The requested edges that are not aligned, worst first.
+    pub unaligned: Vec<UnalignedFeature>,
+}
+
+/// A requested feature edge whose UV image is off an axis.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct UnalignedFeature {
+    /// Input edge id and its end vertices (input ids).
+    pub edge: u32,
+    pub vertices: [u32; 2],
+    /// Deviation from the nearest axis, degrees.
+    pub degrees: f64,
+}
+
 impl Solution<'_> {
+    /// Checks every requested feature edge (`requested`, on the INPUT mesh
+    /// `input`) the way an outside checker does: the UV image of the edge,
+    /// on both faces beside it, must be parallel to an axis.
+    pub fn feature_alignment(&self, input: &TriMesh, requested: &FeatureSet) -> FeatureAlignment {
+        let m = &*self.mesh;
+        let mut worst = vec![f64::NAN; input.n_edges()];
+        for h in 0..3 * m.n_faces() as u32 {
+            let e = m.edge(h);
+            let orig = self.original_edge.as_ref().map_or(e, |oe| oe[e as usize]);
+            if orig == crate::mesh::NONE || !requested.contains(orig) {
+                continue;
+            }
+            let (p, q) = (self.param.uv[h as usize], self.param.uv[m.next(h) as usize]);
+            let dev = param::metrics::axis_deviation((q[1] - p[1]).atan2(q[0] - p[0]));
+            let w = &mut worst[orig as usize];
+            *w = if w.is_nan() { dev } else { w.max(dev) };
+        }
+        let mut unaligned = Vec::new();
+        let mut worst_radians = 0.0f64;
+        for e in requested.edges() {
+            // An edge with no image at all counts as 90° off.
+            let dev = if worst[e as usize].is_nan() { std::f64::consts::FRAC_PI_4 * 2.0 } else { worst[e as usize] };
+            worst_radians = worst_radians.max(dev);
+            if dev > ALIGNED_TOLERANCE {
+                unaligned.push(UnalignedFeature { edge: e, vertices: input.edge_vertices(e), degrees: dev.to_degrees() });
+            }
+        }
+        unaligned.sort_by(|a, b| b.degrees.total_cmp(&a.degrees).then(a.edge.cmp(&b.edge)));
+        let requested_n = requested.len();
+        FeatureAlignment { requested: requested_n, aligned: requested_n - unaligned.len(), worst_radians, unaligned }
+    }
+
     /// The UVs per corner of the INPUT mesh (`3 f + k`): where faces were
     /// split, each input corner takes the UV of that corner in the sub-face
     /// containing it (for display; exports use the solved mesh exactly).
@@ -162,10 +226,10 @@ pub struct Placed {
 }
 
 impl ConeStage {
-    /// Splits doubly constrained triangles and prepares the cone problem.
+    /// Refines the mesh where its features need it ([`refine_for_features`]) and prepares the cone problem.
     pub fn new(mesh: &TriMesh, features: &FeatureSet, options: &SolveOptions) -> ConeStage {
         let started = now_seconds();
-        let refined = split_doubly_constrained(mesh, features);
+        let refined = refine_for_features(mesh, features);
         let refine_seconds = now_seconds() - started;
         ConeStage::with_refinement(mesh, features, options, refined, 0, refine_seconds, started)
     }
@@ -242,19 +306,19 @@ impl Placed {
         progress: &mut dyn FnMut(ParamProgress),
     ) -> Result<Solution<'a>, SolveError> {
         let Placed { options, refined, refine_seconds, placement } = self;
-        let (mesh, features, splits, original_face, original_vertex) = match refined {
-            Some(Refined { mesh: m, features: f, splits, original_face, original_vertex }) => {
-                (Cow::Owned(m), Cow::Owned(f), splits, Some(original_face), Some(original_vertex))
+        let (mesh, features, splits, original_face, original_vertex, original_edge, refinement) = match refined {
+            Some(Refined { mesh: m, features: f, splits, original_face, original_vertex, original_edge, counts }) => {
+                (Cow::Owned(m), Cow::Owned(f), splits, Some(original_face), Some(original_vertex), Some(original_edge), counts)
             }
-            None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None),
+            None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None, None, RefineCounts::default()),
         };
         let param = param::parametrize(&mesh, &placement, &options.param, progress).map_err(SolveError::Param)?;
-        Ok(Solution { mesh, features, splits, original_face, original_vertex, placement, param, refine_seconds })
+        Ok(Solution { mesh, features, splits, original_face, original_vertex, original_edge, refinement, placement, param, refine_seconds })
     }
 }
 
 /// Rounds of local refinement tried when cones of angle 0 appear.
-const MAX_CONE_REFINEMENTS: usize = 2;
+const MAX_CONE_REFINEMENTS: usize = 4;
 
 /// Vertices (of the mesh the placement was computed on) that carry an
 /// interior cone of index `k >= 4`, i.e. a cone angle `<= 0`.

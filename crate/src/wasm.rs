@@ -132,6 +132,21 @@ impl MeshSession {
         Uint32Array::from(&v[..])
     }
 
+    /// Sharp edges above `degrees` without the curves of fewer than
+    /// `min_edges` edges (0: keep all) and, when `closed_only`, without
+    /// dangling ends: `{ edges: Uint32Array, stats }` (`features::SharpStats`).
+    pub fn sharp_curves(&self, degrees: f64, min_edges: u32, closed_only: bool) -> Result<JsValue, JsError> {
+        use crate::features::{detect_sharp, MinLength, SharpOptions};
+        let mesh = self.valid_mesh()?;
+        let min_length = if min_edges > 0 { MinLength::Edges(min_edges as usize) } else { MinLength::None };
+        let found = detect_sharp(mesh, &SharpOptions { threshold_degrees: degrees, min_length, prune_dangling: closed_only });
+        let edges: Vec<u32> = found.features.edges().collect();
+        let out = Object::new();
+        set(&out, "edges", &Uint32Array::from(&edges[..]).into())?;
+        set(&out, "stats", &to_js(&found.stats)?)?;
+        Ok(out.into())
+    }
+
     /// Places cones with `feature_edges` (edge ids) as features.
     /// `progress(stage: string, step: number, remaining: number)` is called
     /// per topology step, rounding round and cone-move pass. Returns
@@ -219,13 +234,13 @@ impl MeshSession {
             notify(progress, stage, a, b);
         };
         let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
-        self.solution_object(mesh, &sol)
+        self.solution_object(mesh, &features, &sol)
     }
 }
 
 impl MeshSession {
     /// The result object of `solve` for the solution `sol` of `mesh`.
-    fn solution_object(&self, mesh: &TriMesh, sol: &Solution) -> Result<JsValue, JsError> {
+    fn solution_object(&self, mesh: &TriMesh, features: &FeatureSet, sol: &Solution) -> Result<JsValue, JsError> {
         let out = cone_result(&sol.placement, sol.features.len())?;
         let uv: Vec<f32> = sol.input_corner_uv(mesh).iter().flat_map(|p| p.map(|c| c as f32)).collect();
         set(&out, "uv", &Float32Array::from(&uv[..]).into())?;
@@ -242,6 +257,8 @@ impl MeshSession {
         set(&out, "metrics", &metrics)?;
         set(&out, "param_timings", &to_js(&sol.param.timings)?)?;
         set(&out, "inserted_vertices", &(sol.splits as f64).into())?;
+        set(&out, "refinement", &to_js(&sol.refinement)?)?;
+        set(&out, "feature_alignment", &to_js(&sol.feature_alignment(mesh, features))?)?;
         // Exports of the solved mesh (with any split edges), exactly.
         let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
         let mut input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &sol.param.uv)

@@ -89,3 +89,23 @@ test('a solve in steps across two sessions equals the one-call solve', () => {
   assert.throws(() => a.solve_finish(() => {}), /do not fit this mesh/);
   assert.equal(a.solve(sharp, 0.01, false, () => {}).energy, whole.energy);
 });
+
+test('sharp curves: filters by curve length and dangling ends, with counts', () => {
+  const session = open(committedFandisk);
+  const all = session.sharp_edges(60);
+  const plain = session.sharp_curves(60, 0, false);
+  assert.deepEqual([...plain.edges], [...all]);
+  assert.equal(plain.stats.sharp_edges, all.length);
+  assert.equal(plain.stats.kept_edges, all.length);
+  assert.equal(plain.stats.dropped_fragments, 0);
+  assert.ok(plain.stats.curves >= 1);
+  // A minimum longer than the longest curve drops every curve.
+  const none = session.sharp_curves(60, all.length + 1, false);
+  assert.equal(none.edges.length, 0);
+  assert.equal(none.stats.dropped_fragments, plain.stats.curves);
+  // Pruning keeps a subset, and never more edges than detected.
+  const closed = session.sharp_curves(60, 0, true);
+  const kept = new Set(all);
+  assert.ok([...closed.edges].every((e) => kept.has(e)));
+  assert.equal(closed.edges.length + closed.stats.pruned_edges, all.length);
+});

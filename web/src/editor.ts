@@ -104,6 +104,9 @@ export class Editor {
     sharpToggle: $<HTMLInputElement>('sharp-toggle'),
     sharpAngle: $<HTMLInputElement>('sharp-angle'),
     sharpValue: $<HTMLOutputElement>('sharp-value'),
+    sharpMinEdges: $<HTMLInputElement>('sharp-min-edges'),
+    sharpClosed: $<HTMLInputElement>('sharp-closed'),
+    sharpStats: $<HTMLElement>('sharp-stats'),
     undo: $<HTMLButtonElement>('undo-button'),
     redo: $<HTMLButtonElement>('redo-button'),
     clear: $<HTMLButtonElement>('clear-features'),
@@ -152,6 +155,9 @@ export class Editor {
     this.anchor = null;
     this.el.sharpToggle.checked = false;
     this.el.sharpAngle.disabled = true;
+    this.el.sharpMinEdges.disabled = true;
+    this.el.sharpClosed.disabled = true;
+    this.el.sharpStats.textContent = '';
     this.clearResult();
     this.el.error.hidden = true;
     this.el.status.hidden = true;
@@ -174,6 +180,7 @@ export class Editor {
     this.uvView.clear();
     this.viewer.setCones([], []);
     this.viewer.setLines('seams', this.mesh?.edges ?? new Uint32Array(0), [], COLORS.seam);
+    this.viewer.setLines('unaligned', this.mesh?.edges ?? new Uint32Array(0), [], COLORS.unaligned);
     this.viewer.setUvSurface(null);
     this.viewer.setHoverFace(null);
   }
@@ -285,12 +292,17 @@ export class Editor {
     const mesh = this.mesh;
     const deg = Number(this.el.sharpAngle.value);
     if (!this.el.sharpToggle.checked) {
+      this.el.sharpStats.textContent = '';
       this.changed(f.setSharp(null));
       return;
     }
+    const minEdges = Math.max(0, Math.floor(Number(this.el.sharpMinEdges.value) || 0));
+    const closedOnly = this.el.sharpClosed.checked;
     try {
-      const { edges } = await this.worker.sharpEdges(deg);
+      const { edges, stats } = await this.worker.sharpEdges(deg, minEdges, closedOnly);
       if (this.mesh !== mesh || !this.el.sharpToggle.checked || Number(this.el.sharpAngle.value) !== deg) return;
+      const dropped = stats.dropped_fragments + (stats.pruned_edges ? ` fragments, ${stats.pruned_edges} dangling edges` : ' fragments');
+      this.el.sharpStats.textContent = `${stats.sharp_edges} sharp edges: ${stats.curves} curves (${stats.kept_edges} edges) kept, ${dropped} dropped`;
       this.changed(f.setSharp(edges));
     } catch (e) {
       if (!(e instanceof Cancelled)) this.showError(`sharp edges: ${e instanceof Error ? e.message : String(e)}`);
@@ -301,10 +313,14 @@ export class Editor {
     const el = this.el;
     el.sharpToggle.addEventListener('change', () => {
       el.sharpAngle.disabled = !el.sharpToggle.checked;
+      el.sharpMinEdges.disabled = !el.sharpToggle.checked;
+      el.sharpClosed.disabled = !el.sharpToggle.checked;
       void this.applySharp();
     });
     el.sharpAngle.addEventListener('input', () => (el.sharpValue.textContent = `${el.sharpAngle.value}°`));
     el.sharpAngle.addEventListener('change', () => void this.applySharp());
+    el.sharpMinEdges.addEventListener('change', () => void this.applySharp());
+    el.sharpClosed.addEventListener('change', () => void this.applySharp());
     el.undo.addEventListener('click', () => this.changed(this.mesh?.features?.undo() ?? false));
     el.redo.addEventListener('click', () => this.changed(this.mesh?.features?.redo() ?? false));
     el.clear.addEventListener('click', () => {
@@ -540,6 +556,11 @@ export class Editor {
     }
     const splits = (r as { inserted_vertices?: number }).inserted_vertices;
     if (typeof splits === 'number' && splits > 0) rows.push(['Inserted vertices (refinement)', fmtInt(splits)]);
+    const alignment = (r as { feature_alignment?: { requested: number; aligned: number; unaligned: Array<{ edge: number; vertices: [number, number]; degrees: number }> } }).feature_alignment;
+    if (alignment && alignment.requested > 0) {
+      const off = alignment.unaligned.slice(0, 5).map((u) => `(v${u.vertices[0]}, v${u.vertices[1]}) ${u.degrees.toFixed(1)}°`).join(', ');
+      rows.push(['Features on isolines', `${fmtInt(alignment.aligned)} / ${fmtInt(alignment.requested)}${off ? ` — off: ${off}` : ''}`]);
+    }
     rows.push(['Time in worker', `${r.elapsed.toFixed(0)} ms`]);
     const list = definitionList(rows);
     const coneDd = list.querySelector<HTMLElement>('dd[data-stat=cones]');
@@ -568,6 +589,8 @@ export class Editor {
       this.viewer.setCones(r.cones, r.boundary_corners);
       this.viewer.setUvSurface({ positions: view.cornerPositions, uv: view.checkerUv, colors });
       this.viewer.setSegments('seams', view.seamSegments, COLORS.seam, 2.5, 2);
+      // Requested features the map left off an axis, drawn over everything.
+      this.viewer.setLines('unaligned', m.edges, alignment?.unaligned.map((u) => u.edge) ?? [], COLORS.unaligned, 5, 3);
       this.setSurface('checker');
       await this.viewer.prepare();
       if (!live()) return false;

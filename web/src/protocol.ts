@@ -19,7 +19,7 @@ export type Request =
       /** Test hook: behave as if the wasm trapped (a Rust panic) during this import. */
       simulateTrap?: boolean;
     }
-  | { id: number; type: 'sharp'; degrees: number }
+  | { id: number; type: 'sharp'; degrees: number; minEdges: number; closedOnly: boolean }
   // A solve in steps (so that a helper worker can place some components):
   // begin → place every component (here, or in a helper and then add) → finish.
   | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean }
@@ -157,6 +157,8 @@ export interface SolveView {
 
 export interface SharpResult {
   edges: Uint32Array;
+  /** Counts of the detection (`features::SharpStats`). */
+  stats: { sharp_edges: number; curves: number; kept_edges: number; dropped_fragments: number; pruned_edges: number };
 }
 
 export type Response =

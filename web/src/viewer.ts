@@ -22,6 +22,7 @@ export const COLORS = {
   feature: 0xff9f1c,
   boundary: 0x2ec4b6,
   seam: 0xff4fa3,
+  unaligned: 0xff1f1f, // requested features the map could not align
   conePlus: 0xe63946, // k = +1 (angle deficit)
   coneMinus: 0x3a86ff, // k = −1 (angle excess)
   coneOther: 0xffd60a, // |k| > 1

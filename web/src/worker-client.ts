@@ -156,9 +156,13 @@ export class MeshWorker {
     return result;
   }
 
-  /** Ids of the interior edges of the open mesh sharper than `degrees`. */
-  sharpEdges(degrees: number): Promise<SharpResult> {
-    return this.send<SharpResult>({ type: 'sharp', degrees });
+  /**
+   * Ids of the interior edges of the open mesh sharper than `degrees`,
+   * without curves of fewer than `minEdges` edges (0: all) and, when
+   * `closedOnly`, without dangling ends; with the detection's counts.
+   */
+  sharpEdges(degrees: number, minEdges = 0, closedOnly = false): Promise<SharpResult> {
+    return this.send<SharpResult>({ type: 'sharp', degrees, minEdges, closedOnly });
   }
 
   /**

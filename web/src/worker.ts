@@ -4,7 +4,7 @@
 // solves do not re-import it.
 import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { ImportResult, MeshReport, Request, Response, SolveResult, SolveView } from './protocol';
+import type { ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView } from './protocol';
 import { buildSolveView, viewBuffers } from './solve-view';
 import { buildAdjacency, faceEdges } from './topology';
 
@@ -28,6 +28,7 @@ interface Session {
   edges(): Uint32Array;
   boundary_edges(): Uint32Array;
   sharp_edges(degrees: number): Uint32Array;
+  sharp_curves(degrees: number, minEdges: number, closedOnly: boolean): SharpResult;
   solve_begin(features: Uint32Array, alpha: number, miq: boolean): Uint32Array;
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
   solve_add(bytes: Uint8Array): void;
@@ -215,8 +216,8 @@ async function handle(req: Request): Promise<void> {
         out = openMesh(req);
         break;
       case 'sharp': {
-        const edges = requireSession().sharp_edges(req.degrees);
-        out = { value: { edges }, transfer: [edges.buffer] };
+        const found = requireSession().sharp_curves(req.degrees, req.minEdges, req.closedOnly);
+        out = { value: found, transfer: [found.edges.buffer] };
         break;
       }
       case 'solve-begin':

@@ -40,18 +40,26 @@ commands:
                        characteristic, genus) and every problem found.
                        --json prints one JSON object instead.
 
-  cones FILE [--alpha A] [--miq] [--sharp DEG] [--features FEATURES.json]
+  cones FILE [--alpha A] [--miq] [--sharp DEG] [--min-feature-length N|X%]
+             [--closed-features] [--features FEATURES.json]
              [--no-moves] [--json]
                        place cones (Myles & Zorin 2013, sections 4-5).
                        --alpha: alpha_smooth, 1e-4..1e3 (default 0.01; 100
                        with --miq). --miq: MIQ emulation (no harmonic
                        minimality). --sharp: edges with dihedral angle above
-                       DEG degrees are features. --features: a JSON file
+                       DEG degrees are features; --min-feature-length N
+                       drops sharp curves (connected sets of sharp edges)
+                       of fewer than N edges, or shorter than X % of the
+                       bounding-box diagonal when given as X%;
+                       --closed-features drops dangling sharp ends, keeping
+                       closed curves and curves that end on other features
+                       or boundaries. --features: a JSON file
                        {\"edges\": [[[x,y,z],[x,y,z]], ...]} of feature edges
                        by end positions. --no-moves: skip the cone-location
                        optimization. --json prints one JSON object.
 
-  solve FILE -o OUT [--alpha A] [--miq] [--sharp DEG] [--features FEATURES.json]
+  solve FILE -o OUT [--alpha A] [--miq] [--sharp DEG] [--min-feature-length N|X%]
+             [--closed-features] [--features FEATURES.json]
              [--no-moves] [--report REPORT.json] [--checker]
                        place cones, compute the seamless parametrization and
                        write the mesh with UVs to OUT: .glb, .gltf (buffer
@@ -74,10 +82,22 @@ problems), 1 when the input could not be read, parsed or used, 2 for bad usage."
 /// Commands and the flags they accept.
 const COMMANDS: &[(&str, &[&str])] = &[
     ("info", &["--json"]),
-    ("cones", &["--json", "--miq", "--no-moves", "--alpha=", "--sharp=", "--features="]),
+    ("cones", &["--json", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features="]),
     (
         "solve",
-        &["--miq", "--no-moves", "--checker", "--alpha=", "--sharp=", "--features=", "--report=", "-o=", "--output="],
+        &[
+            "--miq",
+            "--no-moves",
+            "--checker",
+            "--closed-features",
+            "--alpha=",
+            "--sharp=",
+            "--min-feature-length=",
+            "--features=",
+            "--report=",
+            "-o=",
+            "--output=",
+        ],
     ),
 ];
 
@@ -267,9 +287,31 @@ fn load_mesh(file: &str) -> Result<TriMesh, Failure> {
 
 /// Feature edges from `--sharp` and `--features`.
 fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
+    use conemap::features::{detect_sharp, MinLength, SharpOptions};
     let mut features = FeatureSet::none(mesh);
+    let min_length = match args.value("--min-feature-length") {
+        None => MinLength::None,
+        Some(v) => {
+            let bad = || usage(&format!("--min-feature-length expects a number of edges or a percentage (\"2%\"), got \"{v}\""));
+            match v.strip_suffix('%') {
+                Some(p) => MinLength::DiagonalFraction(p.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0).ok_or_else(bad)? / 100.0),
+                None => MinLength::Edges(v.parse::<usize>().map_err(|_| bad())?),
+            }
+        }
+    };
+    let filtering = min_length != MinLength::None || args.flag("--closed-features");
     if let Some(deg) = args.number("--sharp")? {
-        features.union(&FeatureSet::sharp_edges(mesh, deg));
+        let found = detect_sharp(mesh, &SharpOptions { threshold_degrees: deg, min_length, prune_dangling: args.flag("--closed-features") });
+        if filtering {
+            let s = found.stats;
+            eprintln!(
+                "conemap: sharp edges > {deg}°: {} edges; kept {} curves ({} edges), dropped {} short fragments and {} dangling edges",
+                s.sharp_edges, s.curves, s.kept_edges, s.dropped_fragments, s.pruned_edges
+            );
+        }
+        features.union(&found.features);
+    } else if filtering {
+        return Err(usage("--min-feature-length and --closed-features filter --sharp: give --sharp DEG"));
     }
     if let Some(path) = args.value("--features") {
         let text = std::fs::read_to_string(path).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
@@ -389,9 +431,12 @@ fn solve(args: &Args) -> Result<(), Failure> {
     let t_import = clock.lap();
 
     let features = load_features(args, &mesh)?;
+    let input_mesh = &mesh;
+    let requested = &features;
     let solve_options = SolveOptions { cones: options, param: ParamOptions::default() };
     let solution = pipeline::solve(&mesh, &features, &solve_options, &mut |_| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let (placement, result) = (&solution.placement, &solution.param);
+    let alignment = solution.feature_alignment(input_mesh, requested);
     let t_cones = solution.refine_seconds + placement.timings.total;
     let t_param = clock.lap() - t_cones;
 
@@ -420,6 +465,8 @@ fn solve(args: &Args) -> Result<(), Failure> {
     if let Some(path) = args.value("--report") {
         let mut report = cones_json(mesh, features, &options, placement);
         report["inserted_vertices"] = serde_json::json!(solution.splits);
+        report["refinement"] = serde_json::json!(solution.refinement);
+        report["feature_alignment"] = serde_json::json!(alignment);
         report["metrics"] = serde_json::json!(result.metrics);
         report["seam_edges"] = serde_json::json!(result.seam_edges.len());
         report["arap_iterations"] = serde_json::json!(result.arap_iterations);
@@ -467,8 +514,21 @@ fn solve(args: &Args) -> Result<(), Failure> {
         result.flips_fixed,
         result.seam_edges.len()
     );
+    if requested.len() > 0 {
+        println!(
+            "  feature edges: {} requested, {} on isolines (worst {:.1e} rad)",
+            alignment.requested, alignment.aligned, alignment.worst_radians
+        );
+        for u in alignment.unaligned.iter().take(10) {
+            println!("  warning: feature edge (v{}, v{}) is {:.2}° off an axis", u.vertices[0], u.vertices[1], u.degrees);
+        }
+    }
     if solution.splits > 0 {
-        println!("  note: inserted {} vertices (midpoints of triangles with two constrained edges, centroids around cones of angle 0); the output is the refined mesh", solution.splits);
+        let r = &solution.refinement;
+        println!(
+            "  note: inserted {} vertices ({} lone feature edges opened, {} triangles with three and {} with two constrained edges split, {} enclosed regions given an interior vertex, {} faces split around cones of angle 0); the output is the refined mesh",
+            solution.splits, r.lone_edges, r.triply_constrained, r.doubly_constrained, r.enclosed_regions, r.zero_angle_faces
+        );
     }
     for note in input.notes() {
         println!("  note: {note}");

@@ -21,7 +21,6 @@ use crate::features::{CutMesh, FeatureSet};
 use crate::mesh::TriMesh;
 pub use problem::{ComponentPlacement, ConeProblem, MismatchError};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::FRAC_PI_2;
 pub use system::ConeError;
 
 /// Default `alpha_smooth` (paper: 0.01 in most figures).
@@ -192,23 +191,6 @@ pub fn place_all(problem: &ConeProblem, progress: &mut dyn FnMut(Progress)) -> R
         });
     }
     order.iter().map(|&c| problem.place_component(c, progress)).collect()
-}
-
-/// Turning integer of every boundary vertex, rounded from the geometry:
-/// `round((pi - angle sum) / (pi/2))`, at most 1 so every boundary corner
-/// keeps a parametric angle of at least 90° (a sector sharper than 45°
-/// would otherwise round to a zero angle and collapse); 0 elsewhere.
-pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
-    let sums = crate::operators::angle_sums(mesh.positions(), mesh.faces());
-    (0..mesh.n_vertices() as u32)
-        .map(|v| {
-            if mesh.is_boundary_vertex(v) {
-                (((std::f64::consts::PI - sums[v as usize]) / FRAC_PI_2).round() as i32).min(1)
-            } else {
-                0
-            }
-        })
-        .collect()
 }
 
 /// Cone indices on the input mesh from the cut-vertex integers: a vertex cut

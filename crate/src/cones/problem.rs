@@ -7,9 +7,9 @@
 
 use super::frames::{Frames, Visit};
 use super::system::{ComponentSystem, Weights};
-use super::{boundary_turning, original_cones, ComponentCones, ConeError, ConeOptions, ConePlacement, ConeTimings, Progress};
+use super::{original_cones, ComponentCones, ConeError, ConeOptions, ConePlacement, ConeTimings, Progress};
 use crate::clock::Stopwatch;
-use crate::features::{cut_open, CutMesh, FeatureSet};
+use crate::features::{boundary_turning, cut_open, CutMesh, FeatureSet};
 use crate::mesh::TriMesh;
 use serde::{Deserialize, Serialize};
 use std::fmt;

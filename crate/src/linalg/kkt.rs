@@ -195,3 +195,48 @@ impl NullSpaceProjector {
         y.iter().all(|v| v.is_finite()) && max_abs(&self.residual(y)) <= tolerance * size
     }
 }
+
+/// Incremental sparse Gaussian elimination: `keep[i]` is false when row `i`
+/// is a linear combination of the kept rows before it.
+pub fn independent_rows(rows: &[Vec<(usize, i64)>], n_vars: usize) -> Vec<bool> {
+    row_pivots(rows, n_vars).iter().map(Option::is_some).collect()
+}
+
+/// [`independent_rows`] with the pivot variable of each kept row: the
+/// kept rows restricted to their pivot columns form a nonsingular matrix.
+pub fn row_pivots(rows: &[Vec<(usize, i64)>], n_vars: usize) -> Vec<Option<usize>> {
+    use std::cmp::Reverse;
+    use std::collections::{BinaryHeap, HashMap};
+    let mut pivot_of = vec![usize::MAX; n_vars];
+    let mut stored: Vec<(usize, Vec<(usize, f64)>)> = Vec::new();
+    let mut keep = vec![None; rows.len()];
+    for (ri, r) in rows.iter().enumerate() {
+        let mut work: HashMap<usize, f64> = r.iter().map(|&(i, v)| (i, v as f64)).collect();
+        let mut heap: BinaryHeap<Reverse<(usize, usize)>> =
+            work.keys().filter(|&&v| pivot_of[v] != usize::MAX).map(|&v| Reverse((pivot_of[v], v))).collect();
+        while let Some(Reverse((si, var))) = heap.pop() {
+            let c = match work.get(&var) {
+                Some(&c) if c.abs() > 1e-12 => c,
+                _ => continue,
+            };
+            let srow = &stored[si].1;
+            let pc = srow.iter().find(|e| e.0 == var).map_or(1.0, |e| e.1);
+            let factor = c / pc;
+            for &(v, a) in srow {
+                *work.entry(v).or_insert(0.0) -= factor * a;
+                if v != var && pivot_of[v] != usize::MAX {
+                    heap.push(Reverse((pivot_of[v], v)));
+                }
+            }
+            work.remove(&var);
+        }
+        work.retain(|_, c| c.abs() > 1e-9);
+        let Some((&pv, _)) = work.iter().max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()).then(b.0.cmp(a.0))) else {
+            continue;
+        };
+        keep[ri] = Some(pv);
+        pivot_of[pv] = stored.len();
+        stored.push((pv, work.into_iter().collect()));
+    }
+    keep
+}

@@ -97,7 +97,8 @@ pub fn uv_angle_sums(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<f64> {
     sums
 }
 
-fn axis_deviation(angle: f64) -> f64 {
+/// Angle (radians) from `angle` to the nearest multiple of 90°.
+pub fn axis_deviation(angle: f64) -> f64 {
     (angle - (angle / FRAC_PI_2).round() * FRAC_PI_2).abs()
 }
 

@@ -14,7 +14,7 @@ use super::metrics;
 use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
-use crate::linalg::{constraint_values, Kkt, LdltSolver, NullSpaceProjector, SolveError, SolverOptions, Triplet};
+use crate::linalg::{constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, SolveError, SolverOptions, Triplet};
 use crate::mesh::{TriMesh, UnionFind};
 
 /// Repair rounds tried without lowering the number of folds before giving up.
@@ -125,13 +125,16 @@ impl System {
         if x.iter().any(|v| !v.is_finite()) {
             return Err(ParamError::NotFinite { what: "global solve" });
         }
+        // An inexact solve is off the constraints by about its residual:
+        // project back. The projector works on `C Cᵀ`, which does not depend
+        // on the weights, so it stays exact where heavy repair weights make
+        // the KKT badly scaled.
+        if let Some(projector) = &self.projector {
+            projector.project(&mut x[..self.n_unknowns], CONSTRAINT_TOLERANCE, 3);
+        }
         let (worst, scale) = (self.constraint_residual(&x), scale(&x));
         if worst > 1e-7 * scale {
             return Err(ParamError::ConstraintViolation { residual: worst / scale });
-        }
-        // An inexact solve is off the constraints by about its residual: project back.
-        if let Some(projector) = &self.projector {
-            projector.project(&mut x[..self.n_unknowns], CONSTRAINT_TOLERANCE, 3);
         }
         Ok((0..self.n_wedges).map(|w| [x[self.vars[0][w]], x[self.vars[1][w]]]).collect())
     }
@@ -602,41 +605,3 @@ fn constraint_rows(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2], n_unk
     (triplets, m)
 }
 
-/// Incremental sparse Gaussian elimination: `keep[i]` is false when row `i`
-/// is a linear combination of the kept rows before it.
-fn independent_rows(rows: &[Vec<(usize, i64)>], n_vars: usize) -> Vec<bool> {
-    use std::cmp::Reverse;
-    use std::collections::{BinaryHeap, HashMap};
-    let mut pivot_of = vec![usize::MAX; n_vars];
-    let mut stored: Vec<(usize, Vec<(usize, f64)>)> = Vec::new();
-    let mut keep = vec![false; rows.len()];
-    for (ri, r) in rows.iter().enumerate() {
-        let mut work: HashMap<usize, f64> = r.iter().map(|&(i, v)| (i, v as f64)).collect();
-        let mut heap: BinaryHeap<Reverse<(usize, usize)>> =
-            work.keys().filter(|&&v| pivot_of[v] != usize::MAX).map(|&v| Reverse((pivot_of[v], v))).collect();
-        while let Some(Reverse((si, var))) = heap.pop() {
-            let c = match work.get(&var) {
-                Some(&c) if c.abs() > 1e-12 => c,
-                _ => continue,
-            };
-            let srow = &stored[si].1;
-            let pc = srow.iter().find(|e| e.0 == var).map_or(1.0, |e| e.1);
-            let factor = c / pc;
-            for &(v, a) in srow {
-                *work.entry(v).or_insert(0.0) -= factor * a;
-                if v != var && pivot_of[v] != usize::MAX {
-                    heap.push(Reverse((pivot_of[v], v)));
-                }
-            }
-            work.remove(&var);
-        }
-        work.retain(|_, c| c.abs() > 1e-9);
-        let Some((&pv, _)) = work.iter().max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()).then(b.0.cmp(a.0))) else {
-            continue;
-        };
-        keep[ri] = true;
-        pivot_of[pv] = stored.len();
-        stored.push((pv, work.into_iter().collect()));
-    }
-    keep
-}

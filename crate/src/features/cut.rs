@@ -1,0 +1,166 @@
+//! The mesh cut open along its features (section 4), and the turning
+//! integers its boundary corners get.
+
+use super::FeatureSet;
+use crate::mesh::{TriMesh, UnionFind, NONE};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// A mesh cut open along its feature edges.
+#[derive(Clone, Debug)]
+pub struct CutMesh {
+    /// The cut mesh: each feature edge became two boundary edges.
+    pub mesh: TriMesh,
+    /// Cut vertex → vertex of the original mesh.
+    pub original_vertex: Vec<u32>,
+    /// Cut edge → edge of the original mesh.
+    pub original_edge: Vec<u32>,
+}
+
+impl CutMesh {
+    /// True when boundary edge `e` of the cut mesh comes from a feature
+    /// (rather than from a boundary of the original mesh).
+    pub fn is_feature_edge(&self, original: &TriMesh, e: u32) -> bool {
+        self.mesh.is_boundary_edge(e) && !original.is_boundary_edge(self.original_edge[e as usize])
+    }
+}
+
+/// Cuts `mesh` open along `features`: the corners around each vertex are
+/// split into the sectors separated by feature edges, one new vertex per
+/// sector. Faces keep their indices. An isolated feature edge whose two ends
+/// are interior and touch no other feature cannot be opened (it would become
+/// two edges between the same two vertices) and is left closed.
+pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
+    let mut degree = vec![0u32; mesh.n_vertices()];
+    for e in features.edges() {
+        for v in mesh.edge_vertices(e) {
+            degree[v as usize] += 1;
+        }
+    }
+    let splits = |v: u32| degree[v as usize] >= 2 || mesh.is_boundary_vertex(v);
+    let is_cut = |e: u32| features.contains(e) && mesh.edge_vertices(e).iter().any(|&v| splits(v));
+    // Union corners (3 f + k) across every interior non-feature edge.
+    let n_corners = 3 * mesh.n_faces();
+    let mut corners = UnionFind::new(n_corners);
+    for e in 0..mesh.n_edges() as u32 {
+        if is_cut(e) || mesh.is_boundary_edge(e) {
+            continue;
+        }
+        let [h, t] = mesh.edge_halfedges(e);
+        // Halfedge h = 3f + k runs corner k -> k + 1; its twin runs the other way.
+        let (ht, hh) = (h, 3 * (h / 3) + (h % 3 + 1) % 3);
+        let (tt, th) = (t, 3 * (t / 3) + (t % 3 + 1) % 3);
+        for (a, b) in [(ht, th), (hh, tt)] {
+            corners.union(a, b);
+        }
+    }
+    let mut new_id = vec![NONE; n_corners];
+    let mut original_vertex = Vec::new();
+    let mut faces = Vec::with_capacity(mesh.n_faces());
+    for (f, tri) in mesh.faces().iter().enumerate() {
+        let mut out = [0u32; 3];
+        for k in 0..3 {
+            let r = corners.find((3 * f + k) as u32) as usize;
+            if new_id[r] == NONE {
+                new_id[r] = original_vertex.len() as u32;
+                original_vertex.push(tri[k]);
+            }
+            out[k] = new_id[r];
+        }
+        faces.push(out);
+    }
+    let positions = original_vertex.iter().map(|&v| mesh.position(v)).collect();
+    let cut = TriMesh::from_welded_arrays(positions, faces)
+        .expect("cutting a valid mesh along edges keeps it manifold and oriented");
+    // The builder renumbers vertices by first use; follow its numbering.
+    let original_vertex = cut.welded_to_source().iter().map(|&s| original_vertex[s as usize]).collect();
+    let original_edge = (0..cut.n_edges() as u32)
+        .map(|e| {
+            let h = cut.edge_halfedges(e)[0];
+            mesh.edge(h) // face halfedge numbering is shared (3 f + k)
+        })
+        .collect();
+    CutMesh { mesh: cut, original_vertex, original_edge }
+}
+
+
+/// Turning integer of every boundary vertex (0 elsewhere): the corner's
+/// turning `t_v = (pi - angle sum) / (pi/2)` rounded, at most 1 so every
+/// boundary corner keeps a parametric angle of at least 90° (a sector
+/// sharper than 45° would otherwise round to a zero angle and collapse).
+///
+/// Each corner is rounded on its own (section 4), unless that leaves a
+/// component's interior with much more to carry than its curvature: the
+/// indices of a component add to `4 chi` (Gauss-Bonnet), so the interior
+/// cones must sum to `4 chi - sum k`, against `round(K / (pi/2))` for the
+/// angle defect `K` of the interior vertices. Along a long or jagged feature
+/// loop the rounding errors add up, and a small region enclosed by it would
+/// need cones of angle `<= 0`. Where the two differ by [`MAX_ROUNDING_DRIFT`]
+/// or more, the corners whose rounding was closest to going the other way
+/// are moved until the difference is gone (sum-preserving rounding). Where
+/// the 90° bound leaves no corner to move, the pipeline refines
+/// ([`super::refine_for_features`], [`super::split_around`]).
+pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
+    let sums = crate::operators::angle_sums(mesh.positions(), mesh.faces());
+    let nv = mesh.n_vertices();
+    let turning: Vec<f64> = (0..nv).map(|v| (PI - sums[v]) / FRAC_PI_2).collect();
+    let mut k: Vec<i32> = (0..nv as u32)
+        .map(|v| if mesh.is_boundary_vertex(v) { (turning[v as usize].round() as i32).min(1) } else { 0 })
+        .collect();
+    let nc = mesh.n_components();
+    let mut corners: Vec<Vec<u32>> = vec![Vec::new(); nc];
+    let mut sum = vec![0i64; nc];
+    let mut interior_defect = vec![0.0f64; nc];
+    for v in 0..nv as u32 {
+        let Some(f) = mesh.vertex_faces(v).next() else { continue };
+        let c = mesh.face_components()[f as usize] as usize;
+        if mesh.is_boundary_vertex(v) {
+            corners[c].push(v);
+            sum[c] += k[v as usize] as i64;
+        } else {
+            interior_defect[c] += 2.0 * PI - sums[v as usize];
+        }
+    }
+    for c in 0..nc {
+        let target = 4 * mesh.component_euler_characteristic(c) - (interior_defect[c] / FRAC_PI_2).round() as i64;
+        if (target - sum[c]).abs() < MAX_ROUNDING_DRIFT {
+            continue;
+        }
+        let step: i32 = if sum[c] < target { 1 } else { -1 };
+        let mut need = (target - sum[c]).unsigned_abs() as usize;
+        while need > 0 {
+            // How close each corner's rounding was to going the other way;
+            // exact ties (a regular polygon) are spread by a hash of the vertex.
+            let mut order: Vec<(f64, u64, u32)> = corners[c]
+                .iter()
+                .filter(|&&v| step < 0 || k[v as usize] < 1)
+                .map(|&v| (step as f64 * (turning[v as usize] - k[v as usize] as f64), spread(v), v))
+                .collect();
+            if order.is_empty() {
+                break;
+            }
+            order.sort_by(|a, b| {
+                let close = (a.0 - b.0).abs() < 1e-9;
+                (if close { std::cmp::Ordering::Equal } else { b.0.total_cmp(&a.0) }).then(a.1.cmp(&b.1))
+            });
+            let moved = need.min(order.len());
+            for &(_, _, v) in &order[..moved] {
+                k[v as usize] += step;
+            }
+            need -= moved;
+        }
+    }
+    k
+}
+
+/// Difference (quarter turns) between what a component's interior must
+/// carry after independent corner rounding and its own curvature from which
+/// [`boundary_turning`] rounds the corners as a whole.
+pub const MAX_ROUNDING_DRIFT: i64 = 2;
+
+/// A fixed scramble of a vertex id (splitmix64), to break exact ties evenly.
+fn spread(v: u32) -> u64 {
+    let mut z = (v as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}

@@ -1,0 +1,59 @@
+//! Vertices by position, for feature lists given as end points.
+
+use std::collections::HashMap;
+
+/// Finds mesh vertices by position with a uniform hash grid.
+pub(super) struct VertexLocator<'a> {
+    positions: &'a [[f64; 3]],
+    cell: f64,
+    origin: [f64; 3],
+    grid: HashMap<[i64; 3], Vec<u32>>,
+    tolerance: f64,
+}
+
+impl<'a> VertexLocator<'a> {
+    pub(super) fn new(positions: &'a [[f64; 3]]) -> Self {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in positions {
+            for i in 0..3 {
+                lo[i] = lo[i].min(p[i]);
+                hi[i] = hi[i].max(p[i]);
+            }
+        }
+        let diag = ((0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>()).sqrt().max(f64::MIN_POSITIVE);
+        let tolerance = 1e-6 * diag;
+        let cell = 4.0 * tolerance;
+        let mut locator = VertexLocator { positions, cell, origin: lo, grid: HashMap::new(), tolerance };
+        for (v, p) in positions.iter().enumerate() {
+            let key = locator.key(p);
+            locator.grid.entry(key).or_default().push(v as u32);
+        }
+        locator
+    }
+
+    fn key(&self, p: &[f64; 3]) -> [i64; 3] {
+        [0, 1, 2].map(|i| ((p[i] - self.origin[i]) / self.cell).floor() as i64)
+    }
+
+    /// The nearest vertex within the tolerance, if any.
+    pub(super) fn find(&self, p: &[f64; 3]) -> Option<u32> {
+        let k = self.key(p);
+        let mut best: Option<(f64, u32)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &v in self.grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]).into_iter().flatten() {
+                        let q = self.positions[v as usize];
+                        let d = ((0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>()).sqrt();
+                        if d <= self.tolerance && best.is_none_or(|(bd, _)| d < bd) {
+                            best = Some((d, v));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, v)| v)
+    }
+}
+

@@ -1,0 +1,412 @@
+//! Local refinement that makes a feature set solvable. An aligned seamless
+//! map puts every feature and boundary edge on an isoline; some
+//! configurations admit no such map on the mesh as given, but do after a
+//! few vertices are inserted:
+//! * a lone interior feature edge (both ends interior, touching no other
+//!   feature) cannot be cut open ([`super::cut_open`] would make two edges
+//!   between the same vertices): its midpoint is inserted, and the two
+//!   halves open into a slit;
+//! * a triangle with three constrained (feature or boundary) edges cannot
+//!   have all three on isolines without collapsing: it is split at its centroid;
+//! * a triangle with two constrained edges has all three corners on
+//!   isolines, and collapses where two of them lie on one: its free edge is
+//!   split at its midpoint;
+//! * a region enclosed by features with no interior vertex has no room for
+//!   a cone: where its rounded boundary corners do not sum to `4 chi`
+//!   (Gauss-Bonnet, section 4), no aligned map exists; its largest face is
+//!   split at its centroid, which gives it an interior vertex;
+//! * a vertex that would need a cone of angle 0 ([`split_around`], on
+//!   request of the cone stage): the faces around it are split at their centroids.
+//!
+//! Feature edges are only ever split along themselves, so the refined
+//! features are exactly the pieces of the input features.
+
+use super::cut::{boundary_turning, cut_open};
+use super::FeatureSet;
+use crate::mesh::{TriMesh, NONE};
+use serde::Serialize;
+
+/// Splits made by the refinement, by reason.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct RefineCounts {
+    /// Lone interior feature edges split at their midpoint (they open into a slit).
+    pub lone_edges: usize,
+    /// Triangles with three constrained edges split at their centroid.
+    pub triply_constrained: usize,
+    /// Free edges of triangles with two constrained edges split at their midpoint.
+    pub doubly_constrained: usize,
+    /// Regions enclosed by features without an interior vertex and with
+    /// inconsistent corners, given one (largest face split at its centroid).
+    pub enclosed_regions: usize,
+    /// Faces split at their centroid around vertices that needed a cone of angle 0.
+    pub zero_angle_faces: usize,
+}
+
+impl RefineCounts {
+    fn add(&mut self, o: &RefineCounts) {
+        self.lone_edges += o.lone_edges;
+        self.triply_constrained += o.triply_constrained;
+        self.doubly_constrained += o.doubly_constrained;
+        self.enclosed_regions += o.enclosed_regions;
+        self.zero_angle_faces += o.zero_angle_faces;
+    }
+}
+
+/// A refinement of an input mesh, with its features carried over.
+#[derive(Clone, Debug)]
+pub struct Refined {
+    pub mesh: TriMesh,
+    pub features: FeatureSet,
+    /// Refined face → the input face it lies in.
+    pub original_face: Vec<u32>,
+    /// Refined vertex → input vertex (`NONE` for inserted vertices).
+    pub original_vertex: Vec<u32>,
+    /// Refined edge → the input edge it is (a piece of), `NONE` for edges
+    /// inside input faces.
+    pub original_edge: Vec<u32>,
+    /// Vertices inserted (edge midpoints and face centroids).
+    pub splits: usize,
+    pub counts: RefineCounts,
+}
+
+/// Passes of [`refine_for_features`]; each resolves every configuration it
+/// finds unless two claim the same face, which then waits for the next.
+const MAX_PASSES: usize = 16;
+
+/// Refines `mesh` until none of the configurations of the module doc is
+/// left (or [`MAX_PASSES`] passes ran). Returns `None` when nothing needs it.
+pub fn refine_for_features(mesh: &TriMesh, features: &FeatureSet) -> Option<Refined> {
+    let mut current: Option<Refined> = None;
+    for _ in 0..MAX_PASSES {
+        let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
+        let mut plan = Splits::new(m);
+        plan_local(m, f, &mut plan);
+        if plan.is_empty() {
+            plan_enclosed(m, f, &mut plan);
+        }
+        if plan.is_empty() {
+            break;
+        }
+        current = Some(plan.apply(m, f, current.as_ref()));
+    }
+    current
+}
+
+/// Splits every face around each vertex of `vertices` at its centroid
+/// (1 → 3), on top of the refinement `current` of `mesh` (if any): the
+/// inserted interior vertices can carry curvature a lone vertex cannot
+/// (a cone of index 4 has angle 0). Features are kept.
+pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, vertices: &[u32]) -> Refined {
+    let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
+    let mut plan = Splits::new(m);
+    for &v in vertices {
+        for face in m.vertex_faces(v) {
+            if plan.centroid(face) {
+                plan.counts.zero_angle_faces += 1;
+            }
+        }
+    }
+    plan.apply(m, f, current.as_ref())
+}
+
+/// True when edge `e` of `m` is a feature or boundary edge.
+fn constrained(m: &TriMesh, f: &FeatureSet, e: u32) -> bool {
+    m.is_boundary_edge(e) || f.contains(e)
+}
+
+/// Feature edges at each vertex.
+fn feature_degree(m: &TriMesh, f: &FeatureSet) -> Vec<u32> {
+    let mut degree = vec![0u32; m.n_vertices()];
+    for e in f.edges() {
+        for v in m.edge_vertices(e) {
+            degree[v as usize] += 1;
+        }
+    }
+    degree
+}
+
+/// Plans the splits for lone feature edges and for triangles with two or
+/// three constrained edges.
+fn plan_local(m: &TriMesh, f: &FeatureSet, plan: &mut Splits) {
+    let degree = feature_degree(m, f);
+    let lone = |v: u32| degree[v as usize] == 1 && !m.is_boundary_vertex(v);
+    for e in f.edges() {
+        if m.edge_vertices(e).into_iter().all(lone) && plan.edge(m, e) {
+            plan.counts.lone_edges += 1;
+        }
+    }
+    for face in 0..m.n_faces() as u32 {
+        let hs = m.face_halfedges(face);
+        let c = hs.map(|h| constrained(m, f, m.edge(h)));
+        match c.iter().filter(|&&x| x).count() {
+            3 => {
+                if plan.centroid(face) {
+                    plan.counts.triply_constrained += 1;
+                }
+            }
+            2 => {
+                let free = m.edge(hs[c.iter().position(|&x| !x).expect("one edge is free")]);
+                if plan.edge(m, free) {
+                    plan.counts.doubly_constrained += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Plans a centroid split in every region enclosed by features (component
+/// of the cut mesh) that has no interior vertex and whose rounded boundary
+/// turning does not sum to `4 chi`.
+fn plan_enclosed(m: &TriMesh, f: &FeatureSet, plan: &mut Splits) {
+    let cut = cut_open(m, f);
+    let cm = &cut.mesh;
+    let k = boundary_turning(cm);
+    let nc = cm.n_components();
+    let mut has_interior = vec![false; nc];
+    let mut k_sum = vec![0i64; nc];
+    let component = |v: u32| cm.face_components()[cm.vertex_faces(v).next().expect("vertices have faces") as usize] as usize;
+    for v in 0..cm.n_vertices() as u32 {
+        let c = component(v);
+        has_interior[c] |= !cm.is_boundary_vertex(v);
+        k_sum[c] += k[v as usize] as i64;
+    }
+    // Largest face of each region that needs a vertex (faces keep their ids in the cut).
+    let mut largest: Vec<Option<(f64, u32)>> = vec![None; nc];
+    let areas = crate::operators::face_areas(m.positions(), m.faces());
+    for face in 0..m.n_faces() as u32 {
+        let c = cm.face_components()[face as usize] as usize;
+        if has_interior[c] || k_sum[c] == 4 * cm.component_euler_characteristic(c) {
+            continue;
+        }
+        if largest[c].is_none_or(|(a, _)| areas[face as usize] > a) {
+            largest[c] = Some((areas[face as usize], face));
+        }
+    }
+    for (_, face) in largest.into_iter().flatten() {
+        if plan.centroid(face) {
+            plan.counts.enclosed_regions += 1;
+        }
+    }
+}
+
+/// One pass of splits on a mesh: edges split at their midpoint, faces at
+/// their centroid. A face is claimed by at most one split (so a face has at
+/// most one split edge, and a centroid face none).
+struct Splits {
+    edge: Vec<bool>,
+    centroid: Vec<bool>,
+    claimed: Vec<bool>,
+    counts: RefineCounts,
+}
+
+impl Splits {
+    fn new(m: &TriMesh) -> Splits {
+        Splits { edge: vec![false; m.n_edges()], centroid: vec![false; m.n_faces()], claimed: vec![false; m.n_faces()], counts: RefineCounts::default() }
+    }
+
+    fn is_empty(&self) -> bool {
+        !self.claimed.iter().any(|&c| c)
+    }
+
+    /// Plans splitting edge `e`; false when a face next to it is claimed
+    /// by another split (or `e` is already planned).
+    fn edge(&mut self, m: &TriMesh, e: u32) -> bool {
+        if self.edge[e as usize] {
+            return false;
+        }
+        let faces: Vec<u32> = m.edge_halfedges(e).iter().filter_map(|&h| m.face(h)).collect();
+        if faces.iter().any(|&g| self.claimed[g as usize]) {
+            return false;
+        }
+        for g in faces {
+            self.claimed[g as usize] = true;
+        }
+        self.edge[e as usize] = true;
+        true
+    }
+
+    /// Plans splitting face `face` at its centroid; false when it is claimed.
+    fn centroid(&mut self, face: u32) -> bool {
+        if self.claimed[face as usize] {
+            return false;
+        }
+        self.claimed[face as usize] = true;
+        self.centroid[face as usize] = true;
+        true
+    }
+
+    /// The refinement of `m` (with features `f`, itself the refinement
+    /// `current` of the input, if any) by these splits. Vertices of `m` keep
+    /// their indices; inserted ones follow.
+    fn apply(self, m: &TriMesh, f: &FeatureSet, current: Option<&Refined>) -> Refined {
+        let nv = m.n_vertices();
+        let mut positions = m.positions().to_vec();
+        // Midpoint vertex of each split edge, and the edge each midpoint splits.
+        let mut mid = vec![NONE; m.n_edges()];
+        let mut mid_of = Vec::new();
+        for e in 0..m.n_edges() {
+            if self.edge[e] {
+                let [a, b] = m.edge_vertices(e as u32);
+                mid[e] = positions.len() as u32;
+                mid_of.push(e as u32);
+                positions.push(crate::vec3::midpoint(m.position(a), m.position(b)));
+            }
+        }
+        let n_mid = mid_of.len();
+        let mut triangles = Vec::with_capacity(m.n_faces() + 2 * self.claimed.iter().filter(|&&c| c).count());
+        let mut parent = Vec::with_capacity(triangles.capacity());
+        for face in 0..m.n_faces() as u32 {
+            let v = m.faces()[face as usize];
+            let hs = m.face_halfedges(face);
+            if self.centroid[face as usize] {
+                let p = v.map(|x| m.position(x));
+                let x = positions.len() as u32;
+                positions.push([0, 1, 2].map(|i| (p[0][i] + p[1][i] + p[2][i]) / 3.0));
+                triangles.extend([[v[0], v[1], x], [v[1], v[2], x], [v[2], v[0], x]]);
+                parent.extend([face; 3]);
+            } else if let Some(k) = (0..3).find(|&k| mid[m.edge(hs[k]) as usize] != NONE) {
+                // Halfedge k runs corner k -> k + 1.
+                let x = mid[m.edge(hs[k]) as usize];
+                let (a, b, c) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+                triangles.extend([[a, x, c], [x, b, c]]);
+                parent.extend([face; 2]);
+            } else {
+                triangles.push(v);
+                parent.push(face);
+            }
+        }
+        let inserted = positions.len() - nv;
+        let built = TriMesh::from_welded_arrays(positions, triangles).expect("inserting vertices inside faces or edges keeps the mesh valid");
+        // The builder numbers vertices by first use; rebuild from its own
+        // arrays so that the refined mesh is its own source.
+        let old: Vec<u32> = built.welded_to_source().to_vec();
+        let mesh = TriMesh::from_welded_arrays(built.positions().to_vec(), built.faces().to_vec())
+            .expect("rebuilding a valid mesh from its own arrays");
+        // Each refined edge is an edge of m, half of a split edge, or new.
+        let edge_of_m = |a: u32, b: u32| m.outgoing(a).find(|&h| m.head(h) == b).map(|h| m.edge(h));
+        let parent_edge = |e: u32| -> Option<u32> {
+            let [a, b] = mesh.edge_vertices(e).map(|v| old[v as usize]);
+            let (lo, hi) = (a.min(b) as usize, a.max(b) as usize);
+            if hi < nv {
+                edge_of_m(lo as u32, hi as u32)
+            } else if lo < nv && hi < nv + n_mid {
+                let split = mid_of[hi - nv];
+                m.edge_vertices(split).contains(&(lo as u32)).then_some(split)
+            } else {
+                None
+            }
+        };
+        let mut features = FeatureSet::none(&mesh);
+        let mut original_edge = vec![NONE; mesh.n_edges()];
+        for e in 0..mesh.n_edges() as u32 {
+            if let Some(pe) = parent_edge(e) {
+                if f.contains(pe) {
+                    features.set(&mesh, e, true);
+                }
+                original_edge[e as usize] = current.map_or(pe, |r| r.original_edge[pe as usize]);
+            }
+        }
+        let original_vertex = old
+            .iter()
+            .map(|&s| if (s as usize) >= nv { NONE } else { current.map_or(s, |r| r.original_vertex[s as usize]) })
+            .collect();
+        let original_face = parent.iter().map(|&g| current.map_or(g, |r| r.original_face[g as usize])).collect();
+        let mut counts = current.map_or(RefineCounts::default(), |r| r.counts);
+        counts.add(&self.counts);
+        let splits = current.map_or(0, |r| r.splits) + inserted;
+        Refined { mesh, features, original_face, original_vertex, original_edge, splits, counts }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A flat grid of `n` × `n` squares, each split along its diagonal.
+    fn grid(n: u32) -> TriMesh {
+        let mut p = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                p.push([i as f64, j as f64, 0.0]);
+            }
+        }
+        let id = |i: u32, j: u32| j * (n + 1) + i;
+        let mut t = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        TriMesh::from_welded_arrays(p, t).unwrap()
+    }
+
+    /// The edge between the grid points `a` and `b` (as `(i, j)`).
+    fn edge(m: &TriMesh, a: (u32, u32), b: (u32, u32)) -> u32 {
+        let at = |(i, j): (u32, u32)| (0..m.n_vertices() as u32).find(|&v| m.position(v) == [i as f64, j as f64, 0.0]).unwrap();
+        let (a, b) = (at(a), at(b));
+        m.edge(m.outgoing(a).find(|&h| m.head(h) == b).unwrap())
+    }
+
+    #[test]
+    fn a_lone_edge_is_split_and_both_halves_stay_features() {
+        let m = grid(4);
+        let mut f = FeatureSet::none(&m);
+        let e = edge(&m, (1, 1), (2, 1));
+        f.set(&m, e, true);
+        let r = refine_for_features(&m, &f).expect("a lone edge needs a split");
+        assert_eq!(r.counts.lone_edges, 1);
+        // The two grid corners whose one triangle has two boundary edges.
+        assert_eq!(r.counts.doubly_constrained, 2);
+        assert_eq!(r.splits, 3);
+        assert_eq!(r.features.len(), 2);
+        for fe in r.features.edges() {
+            assert_eq!(r.original_edge[fe as usize], e);
+        }
+        let cut = cut_open(&r.mesh, &r.features);
+        assert_eq!(cut.mesh.boundary_loops().len(), 2, "the outer boundary and the slit");
+    }
+
+    #[test]
+    fn a_triangle_with_three_feature_edges_is_split_at_its_centroid() {
+        let m = grid(4);
+        let mut f = FeatureSet::none(&m);
+        for (a, b) in [((1, 1), (2, 1)), ((2, 1), (2, 2)), ((2, 2), (1, 1))] {
+            f.set(&m, edge(&m, a, b), true);
+        }
+        let r = refine_for_features(&m, &f).unwrap();
+        assert_eq!(r.counts.triply_constrained, 1);
+        for face in 0..r.mesh.n_faces() as u32 {
+            let n = r.mesh.face_halfedges(face).iter().filter(|&&h| constrained(&r.mesh, &r.features, r.mesh.edge(h))).count();
+            assert!(n <= 1, "face {face} keeps {n} constrained edges");
+        }
+        assert!(refine_for_features(&r.mesh, &r.features).is_none(), "nothing left to refine");
+    }
+
+    #[test]
+    fn an_enclosed_region_with_bad_corners_gets_an_interior_vertex() {
+        // A feature ring around the central square of a 3 × 3 grid: the
+        // square's two triangles have two constrained edges each.
+        let m = grid(3);
+        let mut f = FeatureSet::none(&m);
+        for (a, b) in [((1, 1), (2, 1)), ((2, 1), (2, 2)), ((2, 2), (1, 2)), ((1, 2), (1, 1))] {
+            f.set(&m, edge(&m, a, b), true);
+        }
+        let r = refine_for_features(&m, &f).unwrap();
+        // The central square's two triangles share their free edge; the two
+        // grid corners have one triangle with two boundary edges each.
+        assert_eq!(r.counts.doubly_constrained, 3);
+        let cut = cut_open(&r.mesh, &r.features);
+        let k = boundary_turning(&cut.mesh);
+        for c in 0..cut.mesh.n_components() {
+            let sum: i64 = (0..cut.mesh.n_vertices() as u32)
+                .filter(|&v| cut.mesh.face_components()[cut.mesh.vertex_faces(v).next().unwrap() as usize] as usize == c)
+                .map(|v| k[v as usize] as i64)
+                .sum();
+            let interior = (0..cut.mesh.n_vertices() as u32)
+                .any(|v| !cut.mesh.is_boundary_vertex(v) && cut.mesh.face_components()[cut.mesh.vertex_faces(v).next().unwrap() as usize] as usize == c);
+            assert!(interior || sum == 4 * cut.mesh.component_euler_characteristic(c), "component {c}: corners sum to {sum}");
+        }
+    }
+}
