@@ -223,6 +223,15 @@ impl<'a> ComponentSystem<'a> {
             }
         }
 
+        // Pins that repeat others or the fixes peeling made make the KKT
+        // singular: keep an independent set (the boundary rows of a
+        // component are consistent, so the others hold too).
+        let mut rows: Vec<Vec<(usize, i64)>> = (0..ng).filter(|&g| fixed[g].is_some()).map(|g| vec![(g, 1)]).collect();
+        let n_fixed_rows = rows.len();
+        rows.extend(pending.iter().map(|&i| cycles[i].g.iter().map(|&(g, s)| (g as usize, s as i64)).collect()));
+        let keep = crate::linalg::independent_rows(&rows, ng);
+        let pending: Vec<usize> = pending.iter().zip(&keep[n_fixed_rows..]).filter(|(_, &k)| k).map(|(&i, _)| i).collect();
+
         // Assemble.
         let n = nv + nh + ng;
         let h_scale = if weights.miq { 1.0 } else { HARMONIC_WEIGHT.sqrt() };
