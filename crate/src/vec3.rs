@@ -38,3 +38,17 @@ pub fn norm(a: V3) -> f64 {
 pub fn midpoint(a: V3, b: V3) -> V3 {
     scale(add(a, b), 0.5)
 }
+
+/// Corners `(lo, hi)` of the axis-aligned box around `points` (infinite,
+/// inverted, for none).
+pub fn bounds(points: &[V3]) -> (V3, V3) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    (lo, hi)
+}

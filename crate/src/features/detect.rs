@@ -161,14 +161,7 @@ fn edge_length(mesh: &TriMesh, e: u32) -> f64 {
 }
 
 fn bounding_diagonal(mesh: &TriMesh) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in mesh.positions() {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
-    }
+    let (lo, hi) = crate::vec3::bounds(mesh.positions());
     crate::vec3::norm(crate::vec3::sub(hi, lo))
 }
 
@@ -176,25 +169,10 @@ fn bounding_diagonal(mesh: &TriMesh) -> f64 {
 mod tests {
     use super::*;
 
-    /// A flat 4 × 4 grid with a crease of height `h` along x = 2 (rows of
-    /// vertices lifted), so the edges on that line are sharp.
+    /// An `n` × `n` grid whose column `x = n / 2` is lifted by 1: the edges
+    /// on that line are a ridge of 90°.
     fn creased(n: u32) -> TriMesh {
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                let z = if i == n / 2 { 1.0 } else { 0.0 };
-                p.push([i as f64, j as f64, z]);
-            }
-        }
-        let id = |i: u32, j: u32| j * (n + 1) + i;
-        let mut t = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        TriMesh::from_welded_arrays(p, t).unwrap()
+        crate::features::test_grid(n, |i, _| if i == n / 2 { 1.0 } else { 0.0 })
     }
 
     #[test]

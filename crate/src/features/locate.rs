@@ -13,14 +13,7 @@ pub(super) struct VertexLocator<'a> {
 
 impl<'a> VertexLocator<'a> {
     pub(super) fn new(positions: &'a [[f64; 3]]) -> Self {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in positions {
-            for i in 0..3 {
-                lo[i] = lo[i].min(p[i]);
-                hi[i] = hi[i].max(p[i]);
-            }
-        }
+        let (lo, hi) = crate::vec3::bounds(positions);
         let diag = ((0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>()).sqrt().max(f64::MIN_POSITIVE);
         let tolerance = 1e-6 * diag;
         let cell = 4.0 * tolerance;

@@ -115,6 +115,27 @@ impl FeatureSet {
     }
 }
 
+/// A grid of `n` × `n` unit squares in the xy plane, each split along its
+/// diagonal, with height `z(i, j)` at grid point `(i, j)` (tests).
+#[cfg(test)]
+pub(crate) fn test_grid(n: u32, z: impl Fn(u32, u32) -> f64) -> TriMesh {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            p.push([i as f64, j as f64, z(i, j)]);
+        }
+    }
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    TriMesh::from_welded_arrays(p, t).expect("a grid is a valid mesh")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

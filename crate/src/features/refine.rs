@@ -323,23 +323,8 @@ impl Splits {
 mod tests {
     use super::*;
 
-    /// A flat grid of `n` × `n` squares, each split along its diagonal.
     fn grid(n: u32) -> TriMesh {
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                p.push([i as f64, j as f64, 0.0]);
-            }
-        }
-        let id = |i: u32, j: u32| j * (n + 1) + i;
-        let mut t = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-        TriMesh::from_welded_arrays(p, t).unwrap()
+        crate::features::test_grid(n, |_, _| 0.0)
     }
 
     /// The edge between the grid points `a` and `b` (as `(i, j)`).
