@@ -301,8 +301,9 @@ export class Editor {
     try {
       const { edges, stats } = await this.worker.sharpEdges(deg, minEdges, closedOnly);
       if (this.mesh !== mesh || !this.el.sharpToggle.checked || Number(this.el.sharpAngle.value) !== deg) return;
-      const dropped = stats.dropped_fragments + (stats.pruned_edges ? ` fragments, ${stats.pruned_edges} dangling edges` : ' fragments');
-      this.el.sharpStats.textContent = `${stats.sharp_edges} sharp edges: ${stats.curves} curves (${stats.kept_edges} edges) kept, ${dropped} dropped`;
+      const n = (k: number, one: string, many: string) => `${k} ${k === 1 ? one : many}`;
+      const pruned = stats.pruned_edges ? `, ${n(stats.pruned_edges, 'dangling edge', 'dangling edges')}` : '';
+      this.el.sharpStats.textContent = `${n(stats.sharp_edges, 'sharp edge', 'sharp edges')}: ${n(stats.curves, 'curve', 'curves')} (${n(stats.kept_edges, 'edge', 'edges')}) kept, ${n(stats.dropped_fragments, 'fragment', 'fragments')}${pruned} dropped`;
       this.changed(f.setSharp(edges));
     } catch (e) {
       if (!(e instanceof Cancelled)) this.showError(`sharp edges: ${e instanceof Error ? e.message : String(e)}`);
