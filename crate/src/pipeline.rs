@@ -318,7 +318,7 @@ impl Placed {
 }
 
 /// Rounds of local refinement tried when cones of angle 0 appear.
-const MAX_CONE_REFINEMENTS: usize = 2;
+const MAX_CONE_REFINEMENTS: usize = 4;
 
 /// Vertices (of the mesh the placement was computed on) that carry an
 /// interior cone of index `k >= 4`, i.e. a cone angle `<= 0`.
