@@ -30,7 +30,7 @@ const bin = path.join(root, 'target/release/conemap');
 fs.mkdirSync(outDir, { recursive: true });
 
 /** Interior edges of `mesh` (welded by exact position) with dihedral angle above `deg`, as position pairs. */
-export function sharpEdges({ v, faces }, deg) {
+function sharpEdges({ v, faces }, deg) {
   const key = (i) => v[i].join(',');
   const normal = (f) => {
     const [a, b, c] = f.map((c) => v[c[0]]);
@@ -129,7 +129,7 @@ function featureAlignment(out, edges) {
 let failures = 0;
 const rows = [];
 for (const mesh of argv) {
-  const input = parseObj(fs.readFileSync(mesh, 'utf8').replace(/^f (.*)$/gm, (l) => l));
+  const input = parseObj(fs.readFileSync(mesh, 'utf8'));
   const name = path.basename(mesh, '.obj');
   for (const deg of angles) {
     const obj = path.join(outDir, `${name}-${deg}.obj`);

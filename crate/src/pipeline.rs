@@ -119,7 +119,7 @@ impl Solution<'_> {
         let mut worst_radians = 0.0f64;
         for e in requested.edges() {
             // An edge with no image at all counts as 90° off.
-            let dev = if worst[e as usize].is_nan() { std::f64::consts::FRAC_PI_4 * 2.0 } else { worst[e as usize] };
+            let dev = if worst[e as usize].is_nan() { std::f64::consts::FRAC_PI_2 } else { worst[e as usize] };
             worst_radians = worst_radians.max(dev);
             if dev > ALIGNED_TOLERANCE {
                 unaligned.push(UnalignedFeature { edge: e, vertices: input.edge_vertices(e), degrees: dev.to_degrees() });

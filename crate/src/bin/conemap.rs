@@ -431,12 +431,10 @@ fn solve(args: &Args) -> Result<(), Failure> {
     let t_import = clock.lap();
 
     let features = load_features(args, &mesh)?;
-    let input_mesh = &mesh;
-    let requested = &features;
     let solve_options = SolveOptions { cones: options, param: ParamOptions::default() };
     let solution = pipeline::solve(&mesh, &features, &solve_options, &mut |_| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let (placement, result) = (&solution.placement, &solution.param);
-    let alignment = solution.feature_alignment(input_mesh, requested);
+    let alignment = solution.feature_alignment(&mesh, &features);
     let t_cones = solution.refine_seconds + placement.timings.total;
     let t_param = clock.lap() - t_cones;
 
@@ -514,7 +512,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
         result.flips_fixed,
         result.seam_edges.len()
     );
-    if requested.len() > 0 {
+    if alignment.requested > 0 {
         println!(
             "  feature edges: {} requested, {} on isolines (worst {:.1e} rad)",
             alignment.requested, alignment.aligned, alignment.worst_radians

@@ -30,12 +30,7 @@ impl CutMesh {
 /// are interior and touch no other feature cannot be opened (it would become
 /// two edges between the same two vertices) and is left closed.
 pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
-    let mut degree = vec![0u32; mesh.n_vertices()];
-    for e in features.edges() {
-        for v in mesh.edge_vertices(e) {
-            degree[v as usize] += 1;
-        }
-    }
+    let degree = features.degrees(mesh);
     let splits = |v: u32| degree[v as usize] >= 2 || mesh.is_boundary_vertex(v);
     let is_cut = |e: u32| features.contains(e) && mesh.edge_vertices(e).iter().any(|&v| splits(v));
     // Union corners (3 f + k) across every interior non-feature edge.
@@ -111,8 +106,7 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
     let mut sum = vec![0i64; nc];
     let mut interior_defect = vec![0.0f64; nc];
     for v in 0..nv as u32 {
-        let Some(f) = mesh.vertex_faces(v).next() else { continue };
-        let c = mesh.face_components()[f as usize] as usize;
+        let c = mesh.vertex_component(v);
         if mesh.is_boundary_vertex(v) {
             corners[c].push(v);
             sum[c] += k[v as usize] as i64;

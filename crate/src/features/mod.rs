@@ -109,6 +109,17 @@ impl FeatureSet {
         self.len() == 0
     }
 
+    /// Number of feature edges at each vertex of `mesh`.
+    pub fn degrees(&self, mesh: &TriMesh) -> Vec<u32> {
+        let mut degree = vec![0u32; mesh.n_vertices()];
+        for e in self.edges() {
+            for v in mesh.edge_vertices(e) {
+                degree[v as usize] += 1;
+            }
+        }
+        degree
+    }
+
     /// The feature edges, ascending.
     pub fn edges(&self) -> impl Iterator<Item = u32> + '_ {
         self.is_feature.iter().enumerate().filter(|(_, &f)| f).map(|(e, _)| e as u32)

@@ -114,21 +114,10 @@ fn constrained(m: &TriMesh, f: &FeatureSet, e: u32) -> bool {
     m.is_boundary_edge(e) || f.contains(e)
 }
 
-/// Feature edges at each vertex.
-fn feature_degree(m: &TriMesh, f: &FeatureSet) -> Vec<u32> {
-    let mut degree = vec![0u32; m.n_vertices()];
-    for e in f.edges() {
-        for v in m.edge_vertices(e) {
-            degree[v as usize] += 1;
-        }
-    }
-    degree
-}
-
 /// Plans the splits for lone feature edges and for triangles with two or
 /// three constrained edges.
 fn plan_local(m: &TriMesh, f: &FeatureSet, plan: &mut Splits) {
-    let degree = feature_degree(m, f);
+    let degree = f.degrees(m);
     let lone = |v: u32| degree[v as usize] == 1 && !m.is_boundary_vertex(v);
     for e in f.edges() {
         if m.edge_vertices(e).into_iter().all(lone) && plan.edge(m, e) {
@@ -139,11 +128,7 @@ fn plan_local(m: &TriMesh, f: &FeatureSet, plan: &mut Splits) {
         let hs = m.face_halfedges(face);
         let c = hs.map(|h| constrained(m, f, m.edge(h)));
         match c.iter().filter(|&&x| x).count() {
-            3 => {
-                if plan.centroid(face) {
-                    plan.counts.triply_constrained += 1;
-                }
-            }
+            3 => plan.counts.triply_constrained += usize::from(plan.centroid(face)),
             2 => {
                 let free = m.edge(hs[c.iter().position(|&x| !x).expect("one edge is free")]);
                 if plan.edge(m, free) {
@@ -165,9 +150,8 @@ fn plan_enclosed(m: &TriMesh, f: &FeatureSet, plan: &mut Splits) {
     let nc = cm.n_components();
     let mut has_interior = vec![false; nc];
     let mut k_sum = vec![0i64; nc];
-    let component = |v: u32| cm.face_components()[cm.vertex_faces(v).next().expect("vertices have faces") as usize] as usize;
     for v in 0..cm.n_vertices() as u32 {
-        let c = component(v);
+        let c = cm.vertex_component(v);
         has_interior[c] |= !cm.is_boundary_vertex(v);
         k_sum[c] += k[v as usize] as i64;
     }
@@ -386,11 +370,11 @@ mod tests {
         let k = boundary_turning(&cut.mesh);
         for c in 0..cut.mesh.n_components() {
             let sum: i64 = (0..cut.mesh.n_vertices() as u32)
-                .filter(|&v| cut.mesh.face_components()[cut.mesh.vertex_faces(v).next().unwrap() as usize] as usize == c)
+                .filter(|&v| cut.mesh.vertex_component(v) == c)
                 .map(|v| k[v as usize] as i64)
                 .sum();
             let interior = (0..cut.mesh.n_vertices() as u32)
-                .any(|v| !cut.mesh.is_boundary_vertex(v) && cut.mesh.face_components()[cut.mesh.vertex_faces(v).next().unwrap() as usize] as usize == c);
+                .any(|v| !cut.mesh.is_boundary_vertex(v) && cut.mesh.vertex_component(v) == c);
             assert!(interior || sum == 4 * cut.mesh.component_euler_characteristic(c), "component {c}: corners sum to {sum}");
         }
     }

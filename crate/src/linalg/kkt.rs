@@ -199,17 +199,11 @@ impl NullSpaceProjector {
 /// Incremental sparse Gaussian elimination: `keep[i]` is false when row `i`
 /// is a linear combination of the kept rows before it.
 pub fn independent_rows(rows: &[Vec<(usize, i64)>], n_vars: usize) -> Vec<bool> {
-    row_pivots(rows, n_vars).iter().map(Option::is_some).collect()
-}
-
-/// [`independent_rows`] with the pivot variable of each kept row: the
-/// kept rows restricted to their pivot columns form a nonsingular matrix.
-pub fn row_pivots(rows: &[Vec<(usize, i64)>], n_vars: usize) -> Vec<Option<usize>> {
     use std::cmp::Reverse;
     use std::collections::{BinaryHeap, HashMap};
     let mut pivot_of = vec![usize::MAX; n_vars];
     let mut stored: Vec<(usize, Vec<(usize, f64)>)> = Vec::new();
-    let mut keep = vec![None; rows.len()];
+    let mut keep = vec![false; rows.len()];
     for (ri, r) in rows.iter().enumerate() {
         let mut work: HashMap<usize, f64> = r.iter().map(|&(i, v)| (i, v as f64)).collect();
         let mut heap: BinaryHeap<Reverse<(usize, usize)>> =
@@ -234,7 +228,7 @@ pub fn row_pivots(rows: &[Vec<(usize, i64)>], n_vars: usize) -> Vec<Option<usize
         let Some((&pv, _)) = work.iter().max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()).then(b.0.cmp(a.0))) else {
             continue;
         };
-        keep[ri] = Some(pv);
+        keep[ri] = true;
         pivot_of[pv] = stored.len();
         stored.push((pv, work.into_iter().collect()));
     }

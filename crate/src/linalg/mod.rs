@@ -25,7 +25,7 @@ mod tests;
 
 pub use bordered::FixBorder;
 pub use cholesky::{Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
-pub use kkt::{constraint_values, independent_rows, row_pivots, solve_kkt, Kkt, KktSolution, NullSpaceProjector};
+pub use kkt::{constraint_values, independent_rows, solve_kkt, Kkt, KktSolution, NullSpaceProjector};
 pub use pattern::{SymmetricPattern, Triplet, IGNORED_SLOT};
 
 use std::fmt;

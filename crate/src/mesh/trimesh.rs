@@ -368,6 +368,11 @@ impl TriMesh {
     pub fn face_components(&self) -> &[u32] {
         &self.face_component
     }
+    /// Component id of vertex `v` (every vertex of a `TriMesh` has a face).
+    pub fn vertex_component(&self, v: u32) -> usize {
+        let f = self.vertex_faces(v).next().expect("every vertex of a TriMesh lies on a face");
+        self.face_component[f as usize] as usize
+    }
     /// V − E + F of the whole mesh.
     pub fn euler_characteristic(&self) -> i64 {
         self.report.euler_characteristic
