@@ -6,7 +6,7 @@
 
 use crate::clock::{now_seconds, Stopwatch};
 use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
-use crate::features::{refine_for_features, split_around, FeatureSet, RefineCounts, Refined};
+use crate::features::{refine_for_features, split_around, FeatureSet, RefineCounts, Refined, SplitReason};
 use crate::mesh::TriMesh;
 use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrization};
 use std::borrow::Cow;
@@ -63,6 +63,9 @@ pub struct Solution<'a> {
     pub original_edge: Option<Vec<u32>>,
     /// What the refinement split, by reason.
     pub refinement: RefineCounts,
+    /// Times the faces around flipped triangles were split and everything
+    /// solved again ([`Placed::parametrize`]).
+    pub flip_refinements: usize,
     pub placement: ConePlacement,
     pub param: Parametrization,
     /// Seconds spent refining.
@@ -98,6 +101,33 @@ pub struct UnalignedFeature {
 }
 
 impl Solution<'_> {
+    /// Faces (of `mesh`) whose UV triangle is flipped or degenerate.
+    pub fn flipped_faces(&self) -> Vec<u32> {
+        let uv = &self.param.uv;
+        (0..self.mesh.n_faces() as u32)
+            .filter(|&f| !(param::seamless::signed_uv_area([0, 1, 2].map(|k| uv[3 * f as usize + k])) > 0.0))
+            .collect()
+    }
+
+    /// The refinement of the input this solution was computed on (`None`:
+    /// the input itself), to refine further.
+    fn refinement_of_input(&self) -> Option<Refined> {
+        let (Some(original_face), Some(original_vertex), Some(original_edge)) =
+            (&self.original_face, &self.original_vertex, &self.original_edge)
+        else {
+            return None;
+        };
+        Some(Refined {
+            mesh: self.mesh.clone().into_owned(),
+            features: self.features.clone().into_owned(),
+            original_face: original_face.clone(),
+            original_vertex: original_vertex.clone(),
+            original_edge: original_edge.clone(),
+            splits: self.splits,
+            counts: self.refinement,
+        })
+    }
+
     /// Checks every requested feature edge (`requested`, on the INPUT mesh
     /// `input`) the way an outside checker does: the UV image of the edge,
     /// on both faces beside it, must be parallel to an axis.
@@ -180,13 +210,22 @@ pub fn solve<'a>(
     options: &SolveOptions,
     progress: &mut dyn FnMut(SolveProgress),
 ) -> Result<Solution<'a>, SolveError> {
-    let placed = {
-        let mut cone_progress = |p| progress(SolveProgress::Cones(p));
-        let stage = ConeStage::new(mesh, features, options);
-        let results = cones::place_all(stage.problem(), &mut cone_progress).map_err(SolveError::Cones)?;
-        stage.complete(mesh, features, results, &mut cone_progress)?
-    };
-    placed.parametrize(mesh, features, &mut |p| progress(SolveProgress::Param(p)))
+    let placed = place_cones(mesh, features, options, &mut |p| progress(SolveProgress::Cones(p)))?;
+    placed.parametrize(mesh, features, progress)
+}
+
+/// The cone stage of [`solve`] alone: the refinement the features need,
+/// every component placed (on this thread, or two natively), and the
+/// refinements around cones of angle 0.
+pub fn place_cones(
+    mesh: &TriMesh,
+    features: &FeatureSet,
+    options: &SolveOptions,
+    progress: &mut dyn FnMut(cones::Progress),
+) -> Result<Placed, SolveError> {
+    let stage = ConeStage::new(mesh, features, options);
+    let results = cones::place_all(stage.problem(), progress).map_err(SolveError::Cones)?;
+    stage.complete(mesh, features, results, progress)
 }
 
 /// The cone stage of [`solve`] as steps, so that its components can be
@@ -291,15 +330,66 @@ impl ConeStage {
         }
         // Only vertices of `m` are named; lift the refinement one level.
         let mut clock = Stopwatch::start();
-        let refined = Some(split_around(mesh, features, refined, &degenerate));
+        let refined = Some(split_around(mesh, features, refined, &degenerate, SplitReason::ZeroAngleCone));
         refine_seconds += clock.lap();
         Ok(ConeStep::Again(ConeStage::with_refinement(mesh, features, &options, refined, attempt + 1, refine_seconds, started)))
     }
 }
 
 impl Placed {
-    /// The seamless aligned parametrization (Appendix B) on the placed cones.
+    /// The mesh the cones were placed on: the refinement of `input`, or `input`.
+    pub fn mesh<'a>(&'a self, input: &'a TriMesh) -> &'a TriMesh {
+        self.refined.as_ref().map_or(input, |r| &r.mesh)
+    }
+
+    /// What the refinement inserted (all zero when `mesh` is the input).
+    pub fn refinement(&self) -> (usize, RefineCounts) {
+        self.refined.as_ref().map_or((0, RefineCounts::default()), |r| (r.splits, r.counts))
+    }
+
+    /// The seamless aligned parametrization (Appendix B) on the placed
+    /// cones. Where the map keeps flipped triangles, the faces around their
+    /// corners are split and the cones placed again, up to
+    /// [`MAX_FLIP_REFINEMENTS`] times; the result with the fewest flipped
+    /// triangles is returned (a later attempt that fails is dropped).
     pub fn parametrize<'a>(
+        self,
+        mesh: &'a TriMesh,
+        features: &'a FeatureSet,
+        progress: &mut dyn FnMut(SolveProgress),
+    ) -> Result<Solution<'a>, SolveError> {
+        let options = self.options;
+        let mut best = self.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p)))?;
+        for _ in 0..MAX_FLIP_REFINEMENTS {
+            let flipped = best.flipped_faces();
+            if flipped.is_empty() {
+                break;
+            }
+            let mut clock = Stopwatch::start();
+            let mut corners: Vec<u32> = flipped.iter().flat_map(|&f| best.mesh.faces()[f as usize]).collect();
+            corners.sort_unstable();
+            corners.dedup();
+            let refined = split_around(mesh, features, best.refinement_of_input(), &corners, SplitReason::FlippedTriangle);
+            let started = now_seconds();
+            let stage = ConeStage::with_refinement(mesh, features, &options, Some(refined), 0, best.refine_seconds + clock.lap(), started);
+            let mut cone_progress = |p| progress(SolveProgress::Cones(p));
+            let attempt = cones::place_all(stage.problem(), &mut cone_progress)
+                .map_err(SolveError::Cones)
+                .and_then(|results| stage.complete(mesh, features, results, &mut cone_progress))
+                .and_then(|placed| placed.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p))));
+            match attempt {
+                Ok(mut next) if next.param.metrics.flipped < best.param.metrics.flipped => {
+                    next.flip_refinements = best.flip_refinements + 1;
+                    best = next;
+                }
+                _ => break,
+            }
+        }
+        Ok(best)
+    }
+
+    /// One parametrization of the placed cones ([`Self::parametrize`] without the refinement).
+    fn parametrize_once<'a>(
         self,
         mesh: &'a TriMesh,
         features: &'a FeatureSet,
@@ -313,9 +403,24 @@ impl Placed {
             None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None, None, RefineCounts::default()),
         };
         let param = param::parametrize(&mesh, &placement, &options.param, progress).map_err(SolveError::Param)?;
-        Ok(Solution { mesh, features, splits, original_face, original_vertex, original_edge, refinement, placement, param, refine_seconds })
+        Ok(Solution {
+            mesh,
+            features,
+            splits,
+            original_face,
+            original_vertex,
+            original_edge,
+            refinement,
+            flip_refinements: 0,
+            placement,
+            param,
+            refine_seconds,
+        })
     }
 }
+
+/// Rounds of refinement around flipped triangles ([`Placed::parametrize`]).
+pub const MAX_FLIP_REFINEMENTS: usize = 2;
 
 /// Rounds of local refinement tried when cones of angle 0 appear.
 const MAX_CONE_REFINEMENTS: usize = 4;

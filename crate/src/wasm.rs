@@ -5,7 +5,7 @@
 use crate::cones::{self, ComponentPlacement, ConeOptions, ConePlacement, Progress};
 use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::{self, ParamOptions, ParamProgress};
-use crate::pipeline::{ConeStage, Solution, SolveError, SolveOptions};
+use crate::pipeline::{ConeStage, Solution, SolveError, SolveOptions, SolveProgress};
 use crate::features::FeatureSet;
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -150,7 +150,8 @@ impl MeshSession {
     /// Places cones with `feature_edges` (edge ids) as features.
     /// `progress(stage: string, step: number, remaining: number)` is called
     /// per topology step, rounding round and cone-move pass. Returns
-    /// `{cones, boundary_corners, components, rounds, energy, phi_rms, timings}`.
+    /// `{cones, boundary_corners, components, rounds, energy, phi_rms, timings,
+    /// inserted_vertices}` (cones on the mesh refined where the features need it).
     pub fn place_cones(
         &self,
         feature_edges: &[u32],
@@ -158,9 +159,13 @@ impl MeshSession {
         miq: bool,
         progress: &Function,
     ) -> Result<JsValue, JsError> {
-        let (mesh, features, options) = self.request(feature_edges, alpha_smooth, miq)?;
-        let r = cones::place_cones(mesh, &features, &options, &mut cone_progress(progress)).map_err(|e| JsError::new(&e.to_string()))?;
-        Ok(cone_result(&r, features.len())?.into())
+        let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
+        let options = SolveOptions { cones, param: ParamOptions::default() };
+        let placed = crate::pipeline::place_cones(mesh, &features, &options, &mut cone_progress(progress))
+            .map_err(|e| JsError::new(&e.to_string()))?;
+        let out = cone_result(&placed.placement, features.len())?;
+        set(&out, "inserted_vertices", &(placed.refinement().0 as f64).into())?;
+        Ok(out.into())
     }
 }
 
@@ -222,19 +227,27 @@ impl MeshSession {
         let mesh = self.valid_mesh()?;
         let fail = |e: SolveError| JsError::new(&e.to_string());
         let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
-        let mut report = |p: ParamProgress| {
+        let mut report = |p: SolveProgress| {
             let (stage, a, b) = match p {
-                ParamProgress::Field => ("cross-field", 0, 0),
-                ParamProgress::Cut => ("cut", 0, 0),
-                ParamProgress::Poisson => ("poisson", 0, 0),
-                ParamProgress::Arap { iteration, max } => ("arap", iteration, max),
-                ParamProgress::Repair { round, flips } => ("repair", round, flips),
-                ParamProgress::Injective { iteration, max } => ("injective", iteration, max),
+                SolveProgress::Cones(c) => cone_stage(&c),
+                SolveProgress::Param(p) => param_stage(&p),
             };
             notify(progress, stage, a, b);
         };
         let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
         self.solution_object(mesh, &features, &sol)
+    }
+}
+
+/// Stage name and two counters of a parametrization progress report.
+fn param_stage(p: &ParamProgress) -> (&'static str, usize, usize) {
+    match *p {
+        ParamProgress::Field => ("cross-field", 0, 0),
+        ParamProgress::Cut => ("cut", 0, 0),
+        ParamProgress::Poisson => ("poisson", 0, 0),
+        ParamProgress::Arap { iteration, max } => ("arap", iteration, max),
+        ParamProgress::Repair { round, flips } => ("repair", round, flips),
+        ParamProgress::Injective { iteration, max } => ("injective", iteration, max),
     }
 }
 
@@ -258,6 +271,7 @@ impl MeshSession {
         set(&out, "param_timings", &to_js(&sol.param.timings)?)?;
         set(&out, "inserted_vertices", &(sol.splits as f64).into())?;
         set(&out, "refinement", &to_js(&sol.refinement)?)?;
+        set(&out, "flip_refinements", &(sol.flip_refinements as f64).into())?;
         set(&out, "feature_alignment", &to_js(&sol.feature_alignment(mesh, features))?)?;
         // Exports of the solved mesh (with any split edges), exactly.
         let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };

@@ -8,7 +8,7 @@
 use conemap::features::FeatureSet;
 use conemap::io::import_path;
 use conemap::mesh::TriMesh;
-use conemap::pipeline::{solve, SolveOptions, ALIGNED_TOLERANCE};
+use conemap::pipeline::{solve, Solution, SolveOptions, ALIGNED_TOLERANCE};
 use std::path::Path;
 
 const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes");
@@ -20,7 +20,7 @@ fn load(name: &str) -> TriMesh {
 }
 
 /// Solves `mesh` with `features` and checks the map (see the module doc).
-fn check(label: &str, mesh: &TriMesh, features: &FeatureSet) {
+fn check<'a>(label: &str, mesh: &'a TriMesh, features: &'a FeatureSet) -> Solution<'a> {
     let solution = solve(mesh, features, &SolveOptions::default(), &mut |_| {}).unwrap_or_else(|e| panic!("{label}: {e}"));
     let m = &solution.param.metrics;
     assert_eq!(m.flipped, 0, "{label}: flipped triangles");
@@ -30,6 +30,7 @@ fn check(label: &str, mesh: &TriMesh, features: &FeatureSet) {
     assert_eq!(a.requested, features.len());
     assert_eq!(a.aligned, a.requested, "{label}: unaligned features {:?}", &a.unaligned[..a.unaligned.len().min(5)]);
     assert!(a.worst_radians <= ALIGNED_TOLERANCE);
+    solution
 }
 
 fn sweep(name: &str, angles: &[f64]) {
@@ -106,11 +107,27 @@ fn lone_edges_triangles_and_tiny_loops_on_spot() {
     check("spot, loop with a spoke, triangle and lone edge", &mesh, &both);
 }
 
+/// The loop around vertex v1805's fan on teapot.obj: the first map folds
+/// 207 triangles; splitting the faces around their corners and solving
+/// again (`Placed::parametrize`) gives a fold-free map.
+#[test]
+fn a_fan_loop_that_folds_is_refined_until_fold_free() {
+    let mesh = load("teapot.obj");
+    let mut fan = FeatureSet::none(&mesh);
+    for h in mesh.outgoing(1805).collect::<Vec<_>>() {
+        if mesh.face(h).is_some() {
+            fan.set(&mesh, mesh.edge(mesh.next(h)), true);
+        }
+    }
+    let solution = check("teapot, the loop around v1805's fan", &mesh, &fan);
+    assert!(solution.flip_refinements >= 1, "the first map of this loop folds; the refinement must have run");
+    assert!(solution.refinement.flipped_faces > 0);
+}
+
 mod random_features {
     //! Random feature sets (proptest, fixed seed): lone edges, random walks
     //! as curves and small loops around a vertex's fan, on meshes of three
-    //! kinds (closed, disk, genus 1 with a boundary). On teapot.obj the loop around
-    //! some fans (v1805) still leaves folded triangles: see docs/STATUS.md.
+    //! kinds (closed, disk, genus 1 with a boundary).
     use super::*;
     use proptest::prelude::*;
     use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};

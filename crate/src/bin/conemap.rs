@@ -342,13 +342,32 @@ fn cones_command(args: &Args) -> Result<(), Failure> {
     let mesh = load_mesh(file)?;
     let features = load_features(args, &mesh)?;
     let options = cone_options(args)?;
-    let result = cones::place_cones(&mesh, &features, &options, &mut |_| {}).map_err(|e| Failure(e.to_string(), 1))?;
+    let solve_options = conemap::pipeline::SolveOptions { cones: options, param: conemap::param::ParamOptions::default() };
+    let placed = conemap::pipeline::place_cones(&mesh, &features, &solve_options, &mut |_| {})
+        .map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let (solved, result) = (placed.mesh(&mesh), &placed.placement);
+    let (splits, counts) = placed.refinement();
     if args.flag("--json") {
-        println!("{}", cones_json(&mesh, &features, &options, &result));
+        let mut json = cones_json(solved, &features, &options, result);
+        json["inserted_vertices"] = serde_json::json!(splits);
+        json["refinement"] = serde_json::json!(counts);
+        println!("{json}");
     } else {
-        print_cones(file, &mesh, &features, &options, &result);
+        print_cones(file, solved, &features, &options, result);
+        if splits > 0 {
+            println!("  note: {}; cones are on the refined mesh", refinement_note(splits, &counts));
+        }
     }
     Ok(())
+}
+
+/// What the refinement before the cone stage inserted, in words.
+fn refinement_note(splits: usize, r: &conemap::features::RefineCounts) -> String {
+    format!(
+        "inserted {splits} vertices ({} lone feature edges opened, {} triangles with three and {} with two constrained edges split, \
+         {} enclosed regions given an interior vertex, {} faces split around cones of angle 0, {} around flipped triangles)",
+        r.lone_edges, r.triply_constrained, r.doubly_constrained, r.enclosed_regions, r.zero_angle_faces, r.flipped_faces
+    )
 }
 
 fn cones_json(mesh: &TriMesh, features: &FeatureSet, options: &ConeOptions, r: &ConePlacement) -> serde_json::Value {
@@ -464,6 +483,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
         let mut report = cones_json(mesh, features, &options, placement);
         report["inserted_vertices"] = serde_json::json!(solution.splits);
         report["refinement"] = serde_json::json!(solution.refinement);
+        report["flip_refinements"] = serde_json::json!(solution.flip_refinements);
         report["feature_alignment"] = serde_json::json!(alignment);
         report["metrics"] = serde_json::json!(result.metrics);
         report["seam_edges"] = serde_json::json!(result.seam_edges.len());
@@ -522,11 +542,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
         }
     }
     if solution.splits > 0 {
-        let r = &solution.refinement;
-        println!(
-            "  note: inserted {} vertices ({} lone feature edges opened, {} triangles with three and {} with two constrained edges split, {} enclosed regions given an interior vertex, {} faces split around cones of angle 0); the output is the refined mesh",
-            solution.splits, r.lone_edges, r.triply_constrained, r.doubly_constrained, r.enclosed_regions, r.zero_angle_faces
-        );
+        println!("  note: {}; the output is the refined mesh", refinement_note(solution.splits, &solution.refinement));
     }
     for note in input.notes() {
         println!("  note: {note}");

@@ -40,6 +40,17 @@ pub struct RefineCounts {
     pub enclosed_regions: usize,
     /// Faces split at their centroid around vertices that needed a cone of angle 0.
     pub zero_angle_faces: usize,
+    /// Faces split at their centroid around the corners of triangles a map left flipped.
+    pub flipped_faces: usize,
+}
+
+/// Why [`split_around`] splits the faces around some vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplitReason {
+    /// The vertices needed a cone of index >= 4 (angle <= 0).
+    ZeroAngleCone,
+    /// The vertices are corners of triangles the map left flipped.
+    FlippedTriangle,
 }
 
 impl RefineCounts {
@@ -49,6 +60,7 @@ impl RefineCounts {
         self.doubly_constrained += o.doubly_constrained;
         self.enclosed_regions += o.enclosed_regions;
         self.zero_angle_faces += o.zero_angle_faces;
+        self.flipped_faces += o.flipped_faces;
     }
 }
 
@@ -95,14 +107,18 @@ pub fn refine_for_features(mesh: &TriMesh, features: &FeatureSet) -> Option<Refi
 /// Splits every face around each vertex of `vertices` at its centroid
 /// (1 → 3), on top of the refinement `current` of `mesh` (if any): the
 /// inserted interior vertices can carry curvature a lone vertex cannot
-/// (a cone of index 4 has angle 0). Features are kept.
-pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, vertices: &[u32]) -> Refined {
+/// (a cone of index 4 has angle 0), and more freedom to unfold a flipped
+/// triangle. Features are kept; `reason` says which count the splits go to.
+pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, vertices: &[u32], reason: SplitReason) -> Refined {
     let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
     let mut plan = Splits::new(m);
     for &v in vertices {
         for face in m.vertex_faces(v) {
             if plan.centroid(face) {
-                plan.counts.zero_angle_faces += 1;
+                match reason {
+                    SplitReason::ZeroAngleCone => plan.counts.zero_angle_faces += 1,
+                    SplitReason::FlippedTriangle => plan.counts.flipped_faces += 1,
+                }
             }
         }
     }

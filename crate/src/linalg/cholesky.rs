@@ -19,7 +19,16 @@ use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 
 use super::pattern::{SymmetricPattern, Triplet};
+use super::krylov::gmres;
 use super::SolveError;
+
+/// Refinement whose residual falls by less than this factor in a step is
+/// stagnating: the column is finished by GMRES ([`super::krylov`]).
+const STALL_RATIO: f64 = 0.5;
+/// Preconditioner applications GMRES may spend on a stalled column (at least;
+/// the options' `max_refinement_steps` if larger), and its restart length.
+const KRYLOV_STEPS: usize = 60;
+const KRYLOV_RESTART: usize = 30;
 
 /// Tuning of [`LdltSolver`] / [`SparseSpd`]. `delta` and `epsilon` are
 /// *relative* to the largest absolute matrix entry of the factorized values.
@@ -281,6 +290,8 @@ impl Core {
         let mut kx = vec![0.0; n];
         let mut residuals = vec![0.0; n * k];
         let mut active: Vec<usize> = Vec::with_capacity(k);
+        // Columns whose refinement stagnated, finished by GMRES below.
+        let mut stalled: Vec<usize> = Vec::new();
         for step in 0..=opts.max_refinement_steps {
             active.clear();
             for j in 0..k {
@@ -288,6 +299,9 @@ impl Core {
                 if bnorm[j] == 0.0 {
                     // b = 0 ⇒ x = 0 exactly (the solve is linear).
                     info[j].relative_residual = 0.0;
+                    continue;
+                }
+                if stalled.contains(&j) {
                     continue;
                 }
                 if xj.iter().any(|v| !v.is_finite()) {
@@ -299,8 +313,14 @@ impl Core {
                     r[i] = rhs[j * n + i] - kx[i];
                 }
                 let rel = norm2(r) / bnorm[j];
+                let previous = info[j].relative_residual;
                 info[j].relative_residual = rel;
-                if rel >= opts.tolerance && step < opts.max_refinement_steps {
+                if rel < opts.tolerance {
+                    continue;
+                }
+                if (step > 0 && rel > STALL_RATIO * previous) || step == opts.max_refinement_steps {
+                    stalled.push(j);
+                } else if step < opts.max_refinement_steps {
                     active.push(j);
                 }
             }
@@ -316,6 +336,16 @@ impl Core {
                 }
                 info[j].refinement_steps += 1;
             }
+        }
+        for &j in &stalled {
+            let b = &rhs[j * n..(j + 1) * n];
+            let mut apply = |v: &[f64], out: &mut [f64]| self.pattern.mul_vec_unchecked(&self.a_values, v, out);
+            let mut precondition = |v: &mut [f64]| self.raw_solve(v, 1);
+            let xj = &mut x[j * n..(j + 1) * n];
+            let budget = KRYLOV_STEPS.max(opts.max_refinement_steps);
+            let krylov = gmres(&mut apply, &mut precondition, b, xj, opts.tolerance, budget, KRYLOV_RESTART)?;
+            info[j].relative_residual = krylov.relative_residual;
+            info[j].refinement_steps += krylov.steps;
         }
         for inf in &info {
             if inf.relative_residual.is_nan() || inf.relative_residual > opts.accept_residual.max(opts.tolerance) {

@@ -18,6 +18,7 @@
 mod bordered;
 mod cholesky;
 mod kkt;
+mod krylov;
 mod pattern;
 
 #[cfg(test)]
@@ -25,6 +26,7 @@ mod tests;
 
 pub use bordered::FixBorder;
 pub use cholesky::{Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
+pub use krylov::{gmres, KrylovInfo};
 pub use kkt::{constraint_values, independent_rows, solve_kkt, Kkt, KktSolution, NullSpaceProjector};
 pub use pattern::{SymmetricPattern, Triplet, IGNORED_SLOT};
 

@@ -114,9 +114,8 @@ pub(crate) fn he_head(tris: &[[u32; 3]], h: u32) -> u32 {
     tris[(h / 3) as usize][((h % 3 + 1) % 3) as usize]
 }
 
-/// Union-find with path halving and union by index (smaller root wins, so
-/// roots are the first element of each set).
-/// Disjoint sets over `0..n` (path halving; the smaller root wins a union).
+/// Disjoint sets over `0..n` (path halving; the smaller root wins a union,
+/// so each set's root is its first element).
 pub(crate) struct UnionFind {
     parent: Vec<u32>,
 }
