@@ -6,6 +6,7 @@
 // rotation by k·90° (with equal lengths on both sides).
 //
 //   node scripts/feature-sweep.mjs [--angles 20,30,...] [--out DIR] MESH.obj ...
+// (CONEMAP_BIN=path runs another build of the CLI.)
 //
 // Prints one line per run and a summary; exits 1 when any run fails or is off.
 import { spawnSync } from 'node:child_process';
@@ -26,7 +27,7 @@ const take = (name, dflt) => {
 const angles = take('--angles', '20,30,40,50,60,70,80,90,100,110,120,130,140,150').split(',').map(Number);
 const outDir = take('--out', fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-sweep-')));
 const extra = take('--args', '').split(' ').filter(Boolean);
-const bin = path.join(root, 'target/release/conemap');
+const bin = process.env.CONEMAP_BIN || path.join(root, 'target/release/conemap');
 fs.mkdirSync(outDir, { recursive: true });
 
 /** Interior edges of `mesh` (welded by exact position) with dihedral angle above `deg`, as position pairs. */

@@ -324,6 +324,7 @@ impl ConeStage {
         let m = refined.as_ref().map_or(mesh, |r| &r.mesh);
         let mut placement = problem.assemble(m, results).map_err(SolveError::Components)?;
         let degenerate = zero_angle_cones(&placement);
+        if std::env::var("CONEMAP_DEBUG").is_ok() { let m2 = refined.as_ref().map_or(mesh, |r| &r.mesh); eprintln!("ATTEMPT {attempt}: degenerate {:?} k {:?} pos {:?}", degenerate, degenerate.iter().map(|&v| placement.cut.original_vertex.iter().position(|&o| o == v).map(|c| placement.k[c])).collect::<Vec<_>>(), degenerate.iter().map(|&v| m2.position(v)).collect::<Vec<_>>()); }
         if degenerate.is_empty() || attempt == MAX_CONE_REFINEMENTS {
             placement.timings.total = now_seconds() - started - refine_seconds;
             return Ok(ConeStep::Placed(Placed { options, refined, refine_seconds, placement }));

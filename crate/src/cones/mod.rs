@@ -112,6 +112,8 @@ pub struct ComponentCones {
     /// Opposite cone pairs cancelled by the close-pair clean-up and by descent.
     pub merged_pairs: usize,
     pub cancelled_pairs: usize,
+    /// Quarter turns moved off cones of index above 3 (`spread_degenerate_cones`).
+    pub spread_quarter_turns: usize,
     /// Relative residual of the final KKT solve.
     pub residual: f64,
     /// Iterative-refinement steps over all solves.

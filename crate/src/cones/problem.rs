@@ -139,6 +139,8 @@ impl ConeProblem {
         } else {
             0
         };
+        // Last, so that no later step gathers the quarter turns again.
+        let spread = sys.spread_degenerate_cones()?;
 
         let kv = sys.vertex_k();
         let phi = sys.phi().to_vec();
@@ -172,6 +174,7 @@ impl ConeProblem {
             moves,
             merged_pairs: merged,
             cancelled_pairs: cancelled,
+            spread_quarter_turns: spread,
             residual: sys.residual,
             refinement_steps: sys.refinement_steps,
         };

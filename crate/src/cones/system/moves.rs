@@ -21,6 +21,8 @@ const TRIAL_TOLERANCE: f64 = 1e-9;
 const MAX_TRIAL_COLUMNS: usize = 16;
 /// Relative decrease a move or cancellation must bring to be kept.
 const MIN_DECREASE: f64 = 1e-9;
+/// Largest interior cone index with a positive cone angle (`2 pi - k pi/2 > 0`).
+pub(crate) const MAX_CONE_INDEX: i64 = 3;
 
 impl ComponentSystem<'_> {
     /// `sigma_ig`: the sign with which local vertex `i`'s cycle crosses `G`
@@ -148,6 +150,7 @@ impl ComponentSystem<'_> {
                     .one_ring(v)
                     .filter(|&w| !self.mesh.is_boundary_vertex(w))
                     .map(|w| self.local[w as usize] as usize)
+                    .filter(|&j| self.vertex_k_at(j) + ki <= MAX_CONE_INDEX)
                     .map(|j| (2.0 * ki as f64 * (potential[j] - potential[i]), j))
                     .filter(|&(estimate, _)| estimate < -MIN_DECREASE * current)
                     .collect();
@@ -169,9 +172,10 @@ impl ComponentSystem<'_> {
                 for (i, ki, js) in chunk {
                     let (i, start) = (*i, first);
                     first += js.len();
-                    // An earlier move of this pass may have changed this cone.
+                    // An earlier move of this pass may have changed this cone
+                    // or its candidates.
                     let k_now = self.vertex_k_at(i);
-                    if k_now == 0 {
+                    if k_now == 0 || js.iter().any(|&j| self.vertex_k_at(j) + k_now > MAX_CONE_INDEX) {
                         continue;
                     }
                     let own;
@@ -213,6 +217,48 @@ impl ComponentSystem<'_> {
         }
         self.solve()?;
         Ok(moves)
+    }
+
+    /// Splits interior cones of index above [`MAX_CONE_INDEX`] (angle <= 0:
+    /// no seamless map has them), one quarter turn at a time, onto the
+    /// interior vertex within two rings that keeps its index within the
+    /// bound and gives the lowest `phiᵀ M phi / A`. A cone with no such
+    /// vertex is left (the pipeline then refines around it). Returns the
+    /// quarter turns moved.
+    pub fn spread_degenerate_cones(&mut self) -> Result<usize, ConeError> {
+        let mut moved = 0;
+        let dim = self.kkt.pattern.dim();
+        while let Some((i, _)) = self.interior_cones().into_iter().find(|&(_, k)| k > MAX_CONE_INDEX) {
+            let v = self.tree.vertices[i];
+            let mut near: Vec<u32> = self.mesh.one_ring(v).flat_map(|a| self.mesh.one_ring(a).chain([a])).collect();
+            near.sort_unstable();
+            near.dedup();
+            let candidates: Vec<usize> = near
+                .into_iter()
+                .filter(|&w| w != v && !self.mesh.is_boundary_vertex(w))
+                .map(|w| self.local[w as usize] as usize)
+                .filter(|&j| self.vertex_k_at(j) < MAX_CONE_INDEX)
+                .collect();
+            let mut best: Option<(f64, usize, Vec<f64>)> = None;
+            for chunk in candidates.chunks(self.trial_columns()) {
+                let sets: Vec<Vec<Transfer>> = chunk.iter().map(|&j| vec![(i, j, 1)]).collect();
+                let dx = self.responses(&sets)?;
+                for (c, &j) in chunk.iter().enumerate() {
+                    let d = &dx[c * dim..(c + 1) * dim];
+                    let e = self.phi_norm2_at(&self.x, Some(d));
+                    if best.as_ref().is_none_or(|b| e < b.0) {
+                        best = Some((e, j, d.to_vec()));
+                    }
+                }
+            }
+            let Some((_, j, d)) = best else { break };
+            self.accept(&[(i, j, 1)], &d);
+            moved += 1;
+        }
+        if moved > 0 {
+            self.solve()?;
+        }
+        Ok(moved)
     }
 
     /// Unit transfers that cancel every interior cone: each quarter turn of a
