@@ -1,6 +1,7 @@
 //! wasm-bindgen API: thin conversions between JS values and the library.
 //!
-//! Errors cross as JS `Error`s carrying the library's one-line message.
+//! Errors cross as JS `Error`s carrying the library's one-line message; solve
+//! errors that name mesh elements also carry `location` ([`solve_error`]).
 
 use crate::cones::{self, ComponentPlacement, ConeOptions, ConePlacement, Progress};
 use crate::export::{self, ExportInput, ExportOptions};
@@ -170,8 +171,9 @@ impl MeshSession {
     /// Returns the `place_cones` fields plus `uv` (Float32Array, 2 per input
     /// face corner `3 f + k`), `seam_edges` (input edge ids), `metrics`
     /// (with `per_face_distortion`), `timings`, `inserted_vertices` (by the refinement), `glb`
-    /// (Uint8Array) and `obj` (string) of the solved mesh.
-    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool, progress: &Function) -> Result<JsValue, JsError> {
+    /// (Uint8Array) and `obj` (string) of the solved mesh. Solve errors throw
+    /// as `solve_finish` says.
+    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool, progress: &Function) -> Result<JsValue, JsValue> {
         let schedule = self.solve_begin(feature_edges, alpha_smooth, miq)?;
         for c in schedule {
             self.solve_place(c, false, progress)?;
@@ -195,13 +197,17 @@ impl MeshSession {
 
     /// Places component `component` of the started solve and keeps it;
     /// with `share`, also returns it as bytes for `solve_add` in another session.
-    pub fn solve_place(&mut self, component: u32, share: bool, progress: &Function) -> Result<Option<Uint8Array>, JsError> {
+    /// A placement error throws with a `location` where it names mesh elements.
+    pub fn solve_place(&mut self, component: u32, share: bool, progress: &Function) -> Result<Option<Uint8Array>, JsValue> {
         let job = self.job.as_mut().ok_or_else(|| JsError::new("no solve was started"))?;
         let problem = job.stage.problem();
         if component as usize >= problem.n_components() {
-            return Err(JsError::new(&format!("component {component} is out of range ({} components)", problem.n_components())));
+            return Err(JsError::new(&format!("component {component} is out of range ({} components)", problem.n_components())).into());
         }
-        let placed = problem.place_component(component as usize, &mut cone_progress(progress)).map_err(|e| JsError::new(&e.to_string()))?;
+        let mesh = self.mesh.as_ref().ok_or_else(|| JsError::new("no valid mesh is open"))?;
+        let placed = problem
+            .place_component(component as usize, &mut cone_progress(progress))
+            .map_err(|e| solve_error(&job.stage.cone_error(mesh, &job.features, e)))?;
         let bytes = share.then(|| Uint8Array::from(&placed.to_json()[..]));
         job.placed.push(placed);
         Ok(bytes)
@@ -216,11 +222,13 @@ impl MeshSession {
 
     /// Joins the placed components and computes the parametrization (any
     /// refinement around cones of angle 0 is placed here); returns what
-    /// `solve` returns. Ends the started solve.
-    pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsError> {
+    /// `solve` returns. Ends the started solve. Throws an `Error` with the
+    /// solve error's message and, where it names mesh elements, `location:
+    /// {vertices: number[], edges: number[]}` in input ids ([`solve_error`]).
+    pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsValue> {
         let Job { features, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
         let mesh = self.valid_mesh()?;
-        let fail = |e: SolveError| JsError::new(&e.to_string());
+        let fail = |e: SolveError| solve_error(&e);
         let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
         let mut report = |p: ParamProgress| {
             let (stage, a, b) = match p {
@@ -234,7 +242,7 @@ impl MeshSession {
             notify(progress, stage, a, b);
         };
         let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
-        self.solution_object(mesh, &features, &sol)
+        Ok(self.solution_object(mesh, &features, &sol)?)
     }
 }
 
@@ -303,6 +311,19 @@ impl MeshSession {
         }
         Ok(set)
     }
+}
+
+/// A JS `Error` with the message of `e` and, when `e` names mesh elements,
+/// a `location` property `{vertices: number[], edges: number[]}` (input ids).
+fn solve_error(e: &SolveError) -> JsValue {
+    let error = js_sys::Error::new(&e.to_string());
+    if let Some(location) = e.location() {
+        // Without its location the error still says where, in words.
+        if let Ok(value) = serde_wasm_bindgen::to_value(location) {
+            let _ = Reflect::set(&error, &"location".into(), &value);
+        }
+    }
+    error.into()
 }
 
 /// Calls the page's `progress(stage, step, remaining)`; a throwing callback
