@@ -7,7 +7,7 @@
 // Solves run in steps (see protocol.ts): on large meshes a short-lived helper
 // worker opens the same mesh and places some of the cut mesh's components
 // (they are independent), which halves the cone stage on two cores.
-import type { ImportResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
+import type { ErrorLocation, ImportResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
 
 export class WorkerCrashed extends Error {
   override name = 'WorkerCrashed';
@@ -15,6 +15,17 @@ export class WorkerCrashed extends Error {
 
 export class Cancelled extends Error {
   override name = 'Cancelled';
+}
+
+/** A solve error that names mesh elements: `location` has their ids (see protocol.ts). */
+export class LocatedError extends Error {
+  override name = 'LocatedError';
+  constructor(
+    message: string,
+    readonly location: ErrorLocation,
+  ) {
+    super(message);
+  }
 }
 
 export type ProgressFn = (stage: string, step?: number, remaining?: number) => void;
@@ -127,7 +138,7 @@ export class MeshWorker {
           p.reject(new WorkerCrashed(msg.message));
           this.replace(new WorkerCrashed(msg.message));
         } else {
-          p.reject(new Error(msg.message));
+          p.reject(msg.location ? new LocatedError(msg.message, msg.location) : new Error(msg.message));
         }
         break;
     }

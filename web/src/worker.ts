@@ -4,7 +4,7 @@
 // solves do not re-import it.
 import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView } from './protocol';
+import type { ErrorLocation, ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView } from './protocol';
 import { buildSolveView, viewBuffers } from './solve-view';
 import { buildAdjacency, faceEdges } from './topology';
 
@@ -47,6 +47,14 @@ function post(message: Response, transfer: Transferable[] = []): void {
 function errorMessage(e: unknown): string {
   if (e instanceof Error) return e.message || e.name;
   return String(e);
+}
+
+/** The `location` a solve error of the wasm carries (`{vertices, edges}`, see protocol.ts), or null. */
+function errorLocation(e: unknown): ErrorLocation | null {
+  const loc = (e as { location?: unknown } | null)?.location as Partial<ErrorLocation> | undefined;
+  const ids = (a: unknown): a is number[] => Array.isArray(a) && a.every((x) => Number.isInteger(x) && x >= 0);
+  if (!loc || !ids(loc.vertices) || !ids(loc.edges)) return null;
+  return { vertices: loc.vertices, edges: loc.edges };
 }
 
 function openMesh(req: Extract<Request, { type: 'import' }>): Answer {
@@ -234,7 +242,8 @@ async function handle(req: Request): Promise<void> {
     const what = req.type === 'import' ? 'the importer' : 'the solver';
     const message = fatal ? `${what} crashed (${errorMessage(e)}); this is a bug in conemap` : errorMessage(e);
     if (fatal) session = null;
-    post({ id, type: 'error', message, fatal });
+    const location = fatal ? null : errorLocation(e);
+    post({ id, type: 'error', message, fatal, ...(location ? { location } : {}) });
   }
 }
 
