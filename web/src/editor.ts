@@ -437,13 +437,16 @@ export class Editor {
     this.el.error.querySelector('.error-location')?.remove();
   }
 
-  /** Points the camera at the highlighted vertices and edges. */
+  /**
+   * Points the camera at the highlighted vertices, or without any at the
+   * highlighted edges (the edges around a vertex can span the whole mesh).
+   */
   private frameProblem(): void {
     const m = this.mesh;
     const p = this.problem;
     if (!m || !p) return;
     const ends = p.edges.flatMap((e) => [m.edges[2 * e]!, m.edges[2 * e + 1]!]);
-    this.viewer.frameOn([...p.vertices, ...ends]);
+    this.viewer.frameOn(p.vertices.length > 0 ? p.vertices : ends);
   }
 
   private progressText(stage: string, step = 0, remaining = 0): [string, number | undefined] {

@@ -414,7 +414,7 @@ export class Viewer {
     const ids = Array.from(vertices).filter((v) => v < n);
     if (ids.length > 0 && this.data) {
       const box = this.mesh?.geometry.boundingBox;
-      const r = (box ? box.max.distanceTo(box.min) : 1) * 0.012;
+      const r = (box ? box.max.distanceTo(box.min) : 1) * 0.007;
       const material = new THREE.MeshBasicMaterial({ color: COLORS.problem, depthTest: false, transparent: true, opacity: 0.9 });
       const im = new THREE.InstancedMesh(new THREE.SphereGeometry(r, 16, 12), material, ids.length);
       const p = this.data.positions;
@@ -507,8 +507,9 @@ export class Viewer {
 
   /**
    * Points the camera at the vertices `vertices` (ids of the shown mesh):
-   * their bounding sphere (at least 5 % of the mesh's) fills the view, seen
-   * from the side facing away from the mesh's centre. False when none is valid.
+   * their bounding sphere (at least 15 % of the mesh's, for some context)
+   * fills the view, seen from the side facing away from the mesh's centre.
+   * False when none is valid.
    */
   frameOn(vertices: ArrayLike<number>): boolean {
     const sphere = this.mesh?.geometry.boundingSphere;
@@ -520,7 +521,7 @@ export class Viewer {
     const around = new THREE.Sphere().setFromPoints(points);
     const outward = around.center.clone().sub(sphere.center);
     const dir = outward.length() > 1e-6 * sphere.radius ? outward.normalize() : this.camera.position.clone().sub(this.controls.target).normalize();
-    this.look(around.center, Math.max(around.radius, sphere.radius * 0.05), dir);
+    this.look(around.center, Math.max(around.radius, sphere.radius * 0.15), dir);
     return true;
   }
 

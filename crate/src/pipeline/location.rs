@@ -222,15 +222,18 @@ pub(super) fn locate(lift: &Lift, cause: &SolveCause) -> Option<(ErrorLocation, 
             let (edges, complete) = enclosing_features(input, lift.features, &site.faces(input), MAX_LOCATION_EDGES);
             let angle = 360 - 90 * k;
             let what = site.describe(input);
+            // k >= 4 is where the cone placement could not spread the
+            // curvature the features enclose: often a small region around a
+            // sharp vertex, sometimes a large one it rounded badly.
+            let head = format!(
+                "parametrization: the cone at {what} would need index {k} (a cone angle of {angle}°, which no seamless map can have)"
+            );
             let message = if edges.is_empty() {
-                format!(
-                    "parametrization: the cone at {what} would need index {k} (a cone angle of {angle}°): the mesh around it has \
-                     no other interior vertex to carry the curvature; subdivide the mesh there"
-                )
+                format!("{head}: the cone placement found no way to spread the curvature around it over more vertices; subdivide the mesh there")
             } else {
                 format!(
-                    "parametrization: the cone at {what} would need index {k} (a cone angle of {angle}°): {} leave too few \
-                     interior vertices to carry the curvature they enclose; unmark some of them or subdivide the mesh there",
+                    "{head}: the cone placement found no way to spread the curvature enclosed by {} over more vertices; \
+                     unmark some of them or subdivide the mesh there",
                     edge_list(input, &edges, complete)
                 )
             };
@@ -448,7 +451,7 @@ mod tests {
         edges.sort_unstable();
         assert_eq!(edges, rim, "{e}");
         let msg = e.to_string();
-        assert!(msg.contains(&format!("the cone at vertex v{apex} would need index 4 (a cone angle of 0°)")), "{msg}");
+        assert!(msg.contains(&format!("the cone at vertex v{apex} would need index 4 (a cone angle of 0°, ")), "{msg}");
         assert!(msg.contains("the 6 feature edges around it ((v"), "{msg}");
     }
 
@@ -470,7 +473,7 @@ mod tests {
         let mut want = outer;
         want.sort_unstable();
         assert_eq!(got, want);
-        assert!(msg.contains(&format!("the cone at vertex v{centre} would need index 4 (a cone angle of 0°)")), "{msg}");
+        assert!(msg.contains(&format!("the cone at vertex v{centre} would need index 4 (a cone angle of 0°, ")), "{msg}");
         assert!(msg.contains("the 8 feature edges around it ((v"), "{msg}");
         assert!(msg.contains("and 4 more"), "{msg}");
         assert!(msg.contains("unmark some of them"), "{msg}");
