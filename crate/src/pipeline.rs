@@ -3,6 +3,8 @@
 //! of angle 0 and placing them again —, then compute the seamless aligned
 //! parametrization (Appendix B). The CLI calls [`solve`]; the wasm API runs
 //! the same steps ([`ConeStage`]) so that a helper worker can place components.
+//! Errors that name mesh elements carry them in input-mesh indices
+//! ([`SolveError::location`], module `location`).
 
 use crate::clock::{now_seconds, Stopwatch};
 use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
@@ -12,11 +14,34 @@ use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrizatio
 use std::borrow::Cow;
 use std::fmt;
 
+mod location;
+pub use location::{enclosing_features, ErrorLocation, MAX_LOCATION_EDGES};
+use location::Lift;
+
 /// Settings of both stages.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SolveOptions {
     pub cones: ConeOptions,
     pub param: ParamOptions,
+    pub refine: RefineOptions,
+}
+
+/// How often the pipeline refines the mesh and solves again.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RefineOptions {
+    /// Refinements around cones of index >= 4 (angle <= 0) before the solve
+    /// fails with [`crate::param::ParamError::DegenerateCone`]; 0 reports
+    /// what the cone placement alone gives.
+    pub max_cone_refinements: usize,
+    /// Refinements around triangles a map leaves flipped ([`Placed::parametrize`]).
+    pub max_flip_refinements: usize,
+}
+
+impl Default for RefineOptions {
+    fn default() -> Self {
+        // 4: with 2, bff-face at --sharp 60 ended with an index-9 cone.
+        RefineOptions { max_cone_refinements: 4, max_flip_refinements: 2 }
+    }
 }
 
 /// Progress of either stage.
@@ -26,21 +51,60 @@ pub enum SolveProgress {
     Param(ParamProgress),
 }
 
-/// Why solving failed.
+/// What failed. Mesh elements named here are those of the mesh the stage
+/// solved on (the refinement of the input, if any; for cone errors its cut):
+/// [`SolveError::location`] has them in input indices.
 #[derive(Clone, Debug, PartialEq)]
-pub enum SolveError {
+pub enum SolveCause {
     Cones(ConeError),
     /// Component placements from elsewhere that do not fit the stage.
     Components(MismatchError),
     Param(ParamError),
 }
 
-impl fmt::Display for SolveError {
+impl fmt::Display for SolveCause {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SolveError::Cones(e) => write!(f, "{e}"),
-            SolveError::Components(e) => write!(f, "{e}"),
-            SolveError::Param(e) => write!(f, "parametrization: {e}"),
+            SolveCause::Cones(e) => write!(f, "{e}"),
+            SolveCause::Components(e) => write!(f, "{e}"),
+            SolveCause::Param(e) => write!(f, "parametrization: {e}"),
+        }
+    }
+}
+
+/// Why solving failed: the cause and, when it names mesh elements, where
+/// they are on the input mesh (its message then names input indices too).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolveError {
+    pub cause: SolveCause,
+    /// The location and the message in input terms.
+    located: Option<(ErrorLocation, String)>,
+}
+
+impl SolveError {
+    /// `cause` located through `lift` (no location when it names no mesh element).
+    fn new(lift: &Lift, cause: SolveCause) -> SolveError {
+        let located = location::locate(lift, &cause);
+        SolveError { cause, located }
+    }
+
+    /// An error that names no mesh element (component results that do not fit).
+    fn unlocated(cause: SolveCause) -> SolveError {
+        SolveError { cause, located: None }
+    }
+
+    /// The input-mesh vertices and edges the error is about; `None` when it
+    /// names none (e.g. a linear solve that failed).
+    pub fn location(&self) -> Option<&ErrorLocation> {
+        self.located.as_ref().map(|(l, _)| l)
+    }
+}
+
+impl fmt::Display for SolveError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.located {
+            Some((_, message)) => f.write_str(message),
+            None => write!(f, "{}", self.cause),
         }
     }
 }
@@ -224,7 +288,7 @@ pub fn place_cones(
     progress: &mut dyn FnMut(cones::Progress),
 ) -> Result<Placed, SolveError> {
     let stage = ConeStage::new(mesh, features, options);
-    let results = cones::place_all(stage.problem(), progress).map_err(SolveError::Cones)?;
+    let results = cones::place_all(stage.problem(), progress).map_err(|e| stage.cone_error(mesh, features, e))?;
     stage.complete(mesh, features, results, progress)
 }
 
@@ -292,6 +356,12 @@ impl ConeStage {
         &self.problem
     }
 
+    /// `e`, from placing a component of [`Self::problem`], as a [`SolveError`]
+    /// located on the input `mesh` (with its `features`).
+    pub fn cone_error(&self, mesh: &TriMesh, features: &FeatureSet, e: ConeError) -> SolveError {
+        SolveError::new(&lift(mesh, features, self.refined.as_ref()), SolveCause::Cones(e))
+    }
+
     /// Joins the placed components (one per component of [`Self::problem`])
     /// into the placement. Where cones of angle 0 appear, the mesh is refined
     /// around them and the refined stage's components are placed here
@@ -308,7 +378,7 @@ impl ConeStage {
             match stage.finish(mesh, features, results)? {
                 ConeStep::Placed(placed) => return Ok(placed),
                 ConeStep::Again(next) => {
-                    results = cones::place_all(next.problem(), progress).map_err(SolveError::Cones)?;
+                    results = cones::place_all(next.problem(), progress).map_err(|e| next.cone_error(mesh, features, e))?;
                     stage = next;
                 }
             }
@@ -322,10 +392,9 @@ impl ConeStage {
     fn finish(self, mesh: &TriMesh, features: &FeatureSet, results: Vec<ComponentPlacement>) -> Result<ConeStep, SolveError> {
         let ConeStage { options, refined, attempt, mut refine_seconds, started, problem } = self;
         let m = refined.as_ref().map_or(mesh, |r| &r.mesh);
-        let mut placement = problem.assemble(m, results).map_err(SolveError::Components)?;
+        let mut placement = problem.assemble(m, results).map_err(|e| SolveError::unlocated(SolveCause::Components(e)))?;
         let degenerate = zero_angle_cones(&placement);
-        if std::env::var("CONEMAP_DEBUG").is_ok() { let m2 = refined.as_ref().map_or(mesh, |r| &r.mesh); eprintln!("ATTEMPT {attempt}: degenerate {:?} k {:?} pos {:?}", degenerate, degenerate.iter().map(|&v| placement.cut.original_vertex.iter().position(|&o| o == v).map(|c| placement.k[c])).collect::<Vec<_>>(), degenerate.iter().map(|&v| m2.position(v)).collect::<Vec<_>>()); }
-        if degenerate.is_empty() || attempt == MAX_CONE_REFINEMENTS {
+        if degenerate.is_empty() || attempt >= options.refine.max_cone_refinements {
             placement.timings.total = now_seconds() - started - refine_seconds;
             return Ok(ConeStep::Placed(Placed { options, refined, refine_seconds, placement }));
         }
@@ -351,7 +420,7 @@ impl Placed {
     /// The seamless aligned parametrization (Appendix B) on the placed
     /// cones. Where the map keeps flipped triangles, the faces around their
     /// corners are split and the cones placed again, up to
-    /// [`MAX_FLIP_REFINEMENTS`] times; the result with the fewest flipped
+    /// `options.refine.max_flip_refinements` times; the result with the fewest flipped
     /// triangles is returned (a later attempt that fails is dropped).
     pub fn parametrize<'a>(
         self,
@@ -361,7 +430,7 @@ impl Placed {
     ) -> Result<Solution<'a>, SolveError> {
         let options = self.options;
         let mut best = self.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p)))?;
-        for _ in 0..MAX_FLIP_REFINEMENTS {
+        for _ in 0..options.refine.max_flip_refinements {
             let flipped = best.flipped_faces();
             if flipped.is_empty() {
                 break;
@@ -375,7 +444,7 @@ impl Placed {
             let stage = ConeStage::with_refinement(mesh, features, &options, Some(refined), 0, best.refine_seconds + clock.lap(), started);
             let mut cone_progress = |p| progress(SolveProgress::Cones(p));
             let attempt = cones::place_all(stage.problem(), &mut cone_progress)
-                .map_err(SolveError::Cones)
+                .map_err(|e| stage.cone_error(mesh, features, e))
                 .and_then(|results| stage.complete(mesh, features, results, &mut cone_progress))
                 .and_then(|placed| placed.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p))));
             match attempt {
@@ -397,13 +466,25 @@ impl Placed {
         progress: &mut dyn FnMut(ParamProgress),
     ) -> Result<Solution<'a>, SolveError> {
         let Placed { options, refined, refine_seconds, placement } = self;
+        let (input, input_features) = (mesh, features);
         let (mesh, features, splits, original_face, original_vertex, original_edge, refinement) = match refined {
             Some(Refined { mesh: m, features: f, splits, original_face, original_vertex, original_edge, counts }) => {
                 (Cow::Owned(m), Cow::Owned(f), splits, Some(original_face), Some(original_vertex), Some(original_edge), counts)
             }
             None => (Cow::Borrowed(mesh), Cow::Borrowed(features), 0, None, None, None, RefineCounts::default()),
         };
-        let param = param::parametrize(&mesh, &placement, &options.param, progress).map_err(SolveError::Param)?;
+        let param = param::parametrize(&mesh, &placement, &options.param, progress).map_err(|e| {
+            let lift = Lift {
+                input,
+                features: input_features,
+                solved: &mesh,
+                solved_features: &features,
+                original_vertex: original_vertex.as_deref(),
+                original_edge: original_edge.as_deref(),
+                original_face: original_face.as_deref(),
+            };
+            SolveError::new(&lift, SolveCause::Param(e))
+        })?;
         Ok(Solution {
             mesh,
             features,
@@ -420,11 +501,23 @@ impl Placed {
     }
 }
 
-/// Rounds of refinement around flipped triangles ([`Placed::parametrize`]).
-pub const MAX_FLIP_REFINEMENTS: usize = 2;
 
-/// Rounds of local refinement tried when cones of angle 0 appear.
-const MAX_CONE_REFINEMENTS: usize = 4;
+/// The maps from the mesh solved on (`refined`, or `mesh` itself) back to `mesh`.
+fn lift<'a>(mesh: &'a TriMesh, features: &'a FeatureSet, refined: Option<&'a Refined>) -> Lift<'a> {
+    match refined {
+        Some(r) => Lift {
+            input: mesh,
+            features,
+            solved: &r.mesh,
+            solved_features: &r.features,
+            original_vertex: Some(&r.original_vertex),
+            original_edge: Some(&r.original_edge),
+            original_face: Some(&r.original_face),
+        },
+        None => Lift { input: mesh, features, solved: mesh, solved_features: features, original_vertex: None, original_edge: None, original_face: None },
+    }
+}
+
 
 /// Vertices (of the mesh the placement was computed on) that carry an
 /// interior cone of index `k >= 4`, i.e. a cone angle `<= 0`.

@@ -1,11 +1,12 @@
 //! wasm-bindgen API: thin conversions between JS values and the library.
 //!
-//! Errors cross as JS `Error`s carrying the library's one-line message.
+//! Errors cross as JS `Error`s carrying the library's one-line message; solve
+//! errors that name mesh elements also carry `location` ([`solve_error`]).
 
 use crate::cones::{self, ComponentPlacement, ConeOptions, ConePlacement, Progress};
 use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::{self, ParamOptions, ParamProgress};
-use crate::pipeline::{ConeStage, Solution, SolveError, SolveOptions, SolveProgress};
+use crate::pipeline::{ConeStage, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
 use crate::features::FeatureSet;
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -49,6 +50,7 @@ pub struct MeshSession {
     mesh: Option<TriMesh>,
     /// The solve in progress through the `solve_*` steps.
     job: Option<Job>,
+    refine: RefineOptions,
 }
 
 /// A solve run in steps: its features, its cone stage and the components placed so far.
@@ -75,7 +77,14 @@ impl MeshSession {
                 (w.positions, w.triangles)
             }
         };
-        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None })
+        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None, refine: RefineOptions::default() })
+    }
+
+    /// Refinements around cones of angle <= 0 that solves try before they
+    /// fail (`undefined`: the default, 4); 0 shows what the cone placement
+    /// alone gives, with the error's location.
+    pub fn set_max_cone_refinements(&mut self, n: Option<u32>) {
+        self.refine.max_cone_refinements = n.map_or(RefineOptions::default().max_cone_refinements, |n| n as usize);
     }
 
     /// The mesh report (`MeshReport` plus `problem_messages`, one line each).
@@ -160,7 +169,7 @@ impl MeshSession {
         progress: &Function,
     ) -> Result<JsValue, JsError> {
         let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
-        let options = SolveOptions { cones, param: ParamOptions::default() };
+        let options = SolveOptions { cones, param: ParamOptions::default(), refine: self.refine };
         let placed = crate::pipeline::place_cones(mesh, &features, &options, &mut cone_progress(progress))
             .map_err(|e| JsError::new(&e.to_string()))?;
         let out = cone_result(&placed.placement, features.len())?;
@@ -175,8 +184,9 @@ impl MeshSession {
     /// Returns the `place_cones` fields plus `uv` (Float32Array, 2 per input
     /// face corner `3 f + k`), `seam_edges` (input edge ids), `metrics`
     /// (with `per_face_distortion`), `timings`, `inserted_vertices` (by the refinement), `glb`
-    /// (Uint8Array) and `obj` (string) of the solved mesh.
-    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool, progress: &Function) -> Result<JsValue, JsError> {
+    /// (Uint8Array) and `obj` (string) of the solved mesh. Solve errors throw
+    /// as `solve_finish` says.
+    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool, progress: &Function) -> Result<JsValue, JsValue> {
         let schedule = self.solve_begin(feature_edges, alpha_smooth, miq)?;
         for c in schedule {
             self.solve_place(c, false, progress)?;
@@ -192,7 +202,7 @@ impl MeshSession {
     pub fn solve_begin(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool) -> Result<Vec<u32>, JsError> {
         self.job = None;
         let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
-        let stage = ConeStage::new(mesh, &features, &SolveOptions { cones, param: ParamOptions::default() });
+        let stage = ConeStage::new(mesh, &features, &SolveOptions { cones, param: ParamOptions::default(), refine: self.refine });
         let schedule = stage.problem().schedule().iter().map(|&c| c as u32).collect();
         self.job = Some(Job { features, stage, placed: Vec::new() });
         Ok(schedule)
@@ -200,13 +210,17 @@ impl MeshSession {
 
     /// Places component `component` of the started solve and keeps it;
     /// with `share`, also returns it as bytes for `solve_add` in another session.
-    pub fn solve_place(&mut self, component: u32, share: bool, progress: &Function) -> Result<Option<Uint8Array>, JsError> {
+    /// A placement error throws with a `location` where it names mesh elements.
+    pub fn solve_place(&mut self, component: u32, share: bool, progress: &Function) -> Result<Option<Uint8Array>, JsValue> {
         let job = self.job.as_mut().ok_or_else(|| JsError::new("no solve was started"))?;
         let problem = job.stage.problem();
         if component as usize >= problem.n_components() {
-            return Err(JsError::new(&format!("component {component} is out of range ({} components)", problem.n_components())));
+            return Err(JsError::new(&format!("component {component} is out of range ({} components)", problem.n_components())).into());
         }
-        let placed = problem.place_component(component as usize, &mut cone_progress(progress)).map_err(|e| JsError::new(&e.to_string()))?;
+        let mesh = self.mesh.as_ref().ok_or_else(|| JsError::new("no valid mesh is open"))?;
+        let placed = problem
+            .place_component(component as usize, &mut cone_progress(progress))
+            .map_err(|e| solve_error(&job.stage.cone_error(mesh, &job.features, e)))?;
         let bytes = share.then(|| Uint8Array::from(&placed.to_json()[..]));
         job.placed.push(placed);
         Ok(bytes)
@@ -221,11 +235,13 @@ impl MeshSession {
 
     /// Joins the placed components and computes the parametrization (any
     /// refinement around cones of angle 0 is placed here); returns what
-    /// `solve` returns. Ends the started solve.
-    pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsError> {
+    /// `solve` returns. Ends the started solve. Throws an `Error` with the
+    /// solve error's message and, where it names mesh elements, `location:
+    /// {vertices: number[], edges: number[]}` in input ids ([`solve_error`]).
+    pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsValue> {
         let Job { features, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
         let mesh = self.valid_mesh()?;
-        let fail = |e: SolveError| JsError::new(&e.to_string());
+        let fail = |e: SolveError| solve_error(&e);
         let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
         let mut report = |p: SolveProgress| {
             let (stage, a, b) = match p {
@@ -235,7 +251,7 @@ impl MeshSession {
             notify(progress, stage, a, b);
         };
         let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
-        self.solution_object(mesh, &features, &sol)
+        Ok(self.solution_object(mesh, &features, &sol)?)
     }
 }
 
@@ -317,6 +333,19 @@ impl MeshSession {
         }
         Ok(set)
     }
+}
+
+/// A JS `Error` with the message of `e` and, when `e` names mesh elements,
+/// a `location` property `{vertices: number[], edges: number[]}` (input ids).
+fn solve_error(e: &SolveError) -> JsValue {
+    let error = js_sys::Error::new(&e.to_string());
+    if let Some(location) = e.location() {
+        // Without its location the error still says where, in words.
+        if let Ok(value) = serde_wasm_bindgen::to_value(location) {
+            let _ = Reflect::set(&error, &"location".into(), &value);
+        }
+    }
+    error.into()
 }
 
 /// Calls the page's `progress(stage, step, remaining)`; a throwing callback

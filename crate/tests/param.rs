@@ -34,7 +34,7 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
     };
     let options = SolveOptions {
         cones: ConeOptions { alpha_smooth: 0.01, ..ConeOptions::default() },
-        param: ParamOptions::default(),
+        ..SolveOptions::default()
     };
     let solution = solve(&input, &features, &options, &mut |_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
     let (mesh, placement, p) = (&*solution.mesh, &solution.placement, &solution.param);
@@ -110,7 +110,7 @@ fn fandisk_with_sharp_features() {
 fn fandisk_with_sharp_features_has_85_percent_below_0_3() {
     let Some(input) = load("fandisk.obj") else { return };
     let features = FeatureSet::sharp_edges(&input, 60.0);
-    let options = SolveOptions { cones: ConeOptions { alpha_smooth: 0.01, ..ConeOptions::default() }, param: ParamOptions::default() };
+    let options = SolveOptions { cones: ConeOptions { alpha_smooth: 0.01, ..ConeOptions::default() }, param: ParamOptions::default(), ..SolveOptions::default() };
     let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
     let m = &solution.param.metrics;
     assert!(m.fraction_below_0_3 >= 0.85, "fraction below 0.3: {}", m.fraction_below_0_3);
@@ -177,7 +177,7 @@ fn fan_capped_cylinder(n: usize) -> TriMesh {
 fn a_fan_capped_cylinder_with_feature_rims_solves_without_zero_angle_cones() {
     let mesh = fan_capped_cylinder(32);
     assert_eq!(mesh.euler_characteristic(), 2);
-    let options = SolveOptions { cones: ConeOptions::default(), param: ParamOptions::default() };
+    let options = SolveOptions { cones: ConeOptions::default(), param: ParamOptions::default(), ..SolveOptions::default() };
     let rims = FeatureSet::sharp_edges(&mesh, 40.0);
     assert_eq!(rims.len(), 64);
     // Rounded corner by corner, each cap's rim turns by 0 and its centre

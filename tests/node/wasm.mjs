@@ -35,3 +35,23 @@ export function importFiles(wasm, files) {
     ? { name: path.basename(f), bytes: new Uint8Array(fs.readFileSync(f)) }
     : { name: f.name, bytes: new Uint8Array(f.bytes) })));
 }
+
+/**
+ * A needle as OBJ text: a hexagonal pyramid of height `h` over a unit hexagon,
+ * the base fanned from its centre. Its rim (the hexagon) has dihedral angles
+ * of about 92°, the sides meet at about 60°. With the rim as features
+ * (sharp > 75°) it cannot be aligned for h = 25 .. 40: the rim encloses
+ * nearly 2 pi of curvature at the apex, which would need a cone of angle 0.
+ * Side faces start at the rim, so that the refinement renumbers the apex.
+ */
+export function needleObj(h) {
+  const lines = [`v 0 0 ${h}`];
+  for (let i = 0; i < 6; i++) lines.push(`v ${Math.cos((Math.PI * i) / 3)} ${Math.sin((Math.PI * i) / 3)} 0`);
+  lines.push('v 0 0 0');
+  for (let i = 0; i < 6; i++) {
+    const a = 2 + i;
+    const b = 2 + ((i + 1) % 6);
+    lines.push(`f ${a} ${b} 1`, `f 8 ${b} ${a}`);
+  }
+  return `${lines.join('\n')}\n`;
+}

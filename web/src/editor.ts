@@ -3,12 +3,12 @@
 import * as THREE from 'three';
 import { FeatureSet } from './features';
 import { definitionList } from './panels';
-import type { ImportResult, SolveResult, SolveView } from './protocol';
+import type { ErrorLocation, ImportResult, SolveResult, SolveView } from './protocol';
 import { buildSolveView } from './solve-view';
 import { type Adjacency, shortestPath } from './topology';
 import { UvView } from './uvview';
 import { COLORS, type SurfaceMode, type Viewer, heat } from './viewer';
-import { Cancelled, type MeshWorker } from './worker-client';
+import { Cancelled, LocatedError, type MeshWorker } from './worker-client';
 
 /** The test hooks the editor keeps up to date (part of `window.__conemap`, see main.ts). */
 export interface EditorHooks {
@@ -18,6 +18,10 @@ export interface EditorHooks {
   result: ResultHook | null;
   /** Message of the last failed solve (null after a successful one). */
   solveError: string | null;
+  /** The `location` of the last failed solve's error (null after a success, or when it names no mesh element). */
+  solveErrorLocation: ErrorLocation | null;
+  /** What the 3D view highlights of that location (valid ids only); null once cleared (Run, new mesh, feature change). */
+  errorHighlight: ErrorLocation | null;
   /** Increments on every finished solve (success, failure or cancel). */
   solves: number;
   /** Face highlighted in the 3D and UV views (hover sync), or null. */
@@ -95,6 +99,8 @@ export class Editor {
   /** Bumped whenever the shown result is cleared: a view build that sees it change stops. */
   private viewEpoch = 0;
   private result: SolveResult | null = null;
+  /** The solve error's location highlighted in the 3D view (null: none shown). */
+  private problem: ErrorLocation | null = null;
   private resultSettings: Record<string, unknown> | null = null;
   private uvView: UvView;
   private roundingStart = 0;
@@ -159,6 +165,8 @@ export class Editor {
     this.el.sharpClosed.disabled = true;
     this.el.sharpStats.textContent = '';
     this.clearResult();
+    this.clearProblem();
+    this.hooks.solveErrorLocation = null;
     this.el.error.hidden = true;
     this.el.status.hidden = true;
     if (features) this.viewer.setLines('boundary', edges, data.boundary, COLORS.boundary, 3, 0);
@@ -218,6 +226,8 @@ export class Editor {
 
   private changed(did: boolean): void {
     if (!did) return;
+    // A failed solve's highlight is about the features it ran with.
+    this.clearProblem();
     this.redrawFeatures();
     if (this.result && !this.solving) {
       this.el.status.textContent = 'Features changed since this result: Run again to update it.';
@@ -370,9 +380,73 @@ export class Editor {
 
   // ---- solve ------------------------------------------------------------
 
-  private showError(message: string): void {
-    this.el.error.textContent = message;
+  /** Shows an error; with a `location` (a solve error), highlights it in 3D and says so, with a button framing it. */
+  private showError(message: string, location: ErrorLocation | null = null): void {
+    const text = document.createElement('div');
+    text.className = 'error-text';
+    text.textContent = message;
+    this.el.error.replaceChildren(text);
     this.el.error.hidden = false;
+    const shown = location ? this.showProblem(location) : null;
+    if (!shown) return;
+    const line = document.createElement('div');
+    line.className = 'error-location';
+    line.dataset['testid'] = 'error-location';
+    const what: string[] = [];
+    const v = shown.vertices;
+    if (v.length === 1) what.push(`vertex v${v[0]} (marker)`);
+    else if (v.length > 1) what.push(`vertices ${v.map((x) => `v${x}`).join(', ')} (markers)`);
+    const n = shown.edges.length;
+    if (n > 0) what.push(`${fmtInt(n)} ${n === 1 ? 'edge' : 'edges'}`);
+    const swatch = document.createElement('span');
+    swatch.className = 'swatch line problem';
+    const label = document.createElement('span');
+    label.append(swatch, `Highlighted in the 3D view: ${what.join(' and ')}.`);
+    const button = document.createElement('button');
+    button.type = 'button';
+    button.className = 'button small';
+    button.dataset['testid'] = 'show-problem';
+    button.textContent = 'Show in 3D';
+    button.addEventListener('click', () => this.frameProblem());
+    line.append(label, button);
+    this.el.error.append(line);
+  }
+
+  /** Draws `loc` (its ids that exist on this mesh) in the 3D view; returns what is drawn, or null when nothing is. */
+  private showProblem(loc: ErrorLocation): ErrorLocation | null {
+    const m = this.mesh;
+    this.clearProblem();
+    if (!m) return null;
+    const vertices = loc.vertices.filter((v) => v < m.data.positions.length / 3);
+    const edges = loc.edges.filter((e) => e < m.edges.length / 2);
+    if (vertices.length === 0 && edges.length === 0) return null;
+    this.viewer.setLines('problem', m.edges, edges, COLORS.problem, 5, 4);
+    this.viewer.setProblemVertices(vertices);
+    this.problem = { vertices, edges };
+    this.hooks.errorHighlight = { vertices: [...vertices], edges: [...edges] };
+    return this.problem;
+  }
+
+  /** Removes the highlight of a solve error (the message stays). */
+  private clearProblem(): void {
+    if (!this.problem) return;
+    this.problem = null;
+    this.hooks.errorHighlight = null;
+    this.viewer.setLines('problem', this.mesh?.edges ?? new Uint32Array(0), [], COLORS.problem);
+    this.viewer.setProblemVertices([]);
+    this.el.error.querySelector('.error-location')?.remove();
+  }
+
+  /**
+   * Points the camera at the highlighted vertices, or without any at the
+   * highlighted edges (the edges around a vertex can span the whole mesh).
+   */
+  private frameProblem(): void {
+    const m = this.mesh;
+    const p = this.problem;
+    if (!m || !p) return;
+    const ends = p.edges.flatMap((e) => [m.edges[2 * e]!, m.edges[2 * e + 1]!]);
+    this.viewer.frameOn(p.vertices.length > 0 ? p.vertices : ends);
   }
 
   private progressText(stage: string, step = 0, remaining = 0): [string, number | undefined] {
@@ -436,6 +510,7 @@ export class Editor {
     this.el.status.hidden = true;
     document.body.dataset['solving'] = 'true';
     this.el.error.hidden = true;
+    this.clearProblem();
     this.el.progress.hidden = false;
     this.roundingStart = 0;
     this.setProgress('starting');
@@ -455,6 +530,7 @@ export class Editor {
       const aborted = new Promise<boolean>((resolve) => (this.abortBuild = () => resolve(false)));
       if (!(await Promise.race([this.showResult(m, result), aborted]))) throw new Cancelled('cancelled while building the view');
       this.hooks.solveError = null;
+      this.hooks.solveErrorLocation = null;
       this.setState('solved');
     } catch (e) {
       if (this.mesh !== m) return;
@@ -462,8 +538,10 @@ export class Editor {
         this.setState(this.result ? 'solved' : 'ready');
       } else {
         const message = e instanceof Error ? e.message : String(e);
+        const location = e instanceof LocatedError ? e.location : null;
         this.hooks.solveError = message;
-        this.showError(message);
+        this.hooks.solveErrorLocation = location;
+        this.showError(message, location);
         this.setState(this.result ? 'solved' : 'ready');
       }
     } finally {
@@ -702,6 +780,26 @@ export class Editor {
   }
 
   // ---- test hooks -------------------------------------------------------
+
+  /** Position of vertex `v` of the open mesh, or null. */
+  vertexPosition(v: number): [number, number, number] | null {
+    const p = this.mesh?.data.positions;
+    if (!p || v < 0 || 3 * v + 2 >= p.length) return null;
+    return [p[3 * v]!, p[3 * v + 1]!, p[3 * v + 2]!];
+  }
+
+  /** End vertices of edge `e` of the open mesh, or null. */
+  edgeEnds(e: number): [number, number] | null {
+    const m = this.mesh;
+    if (!m || e < 0 || 2 * e + 1 >= m.edges.length) return null;
+    return [m.edges[2 * e]!, m.edges[2 * e + 1]!];
+  }
+
+  /** Page position of vertex `v` (client CSS px), or null. */
+  projectVertex(v: number): { x: number; y: number } | null {
+    const q = this.vertexPosition(v);
+    return q ? this.viewer.projectPoint(q[0], q[1], q[2]) : null;
+  }
 
   projectEdge(e: number): { x: number; y: number } | null {
     const m = this.mesh;

@@ -35,6 +35,12 @@ declare global {
       edgeAt(x: number, y: number): number;
       /** Smallest mesh (faces) whose solves use a helper worker; `wait`: start placing once it is ready. */
       setHelper(minFaces: number, wait: boolean): void;
+      /** Refinements around cones of angle 0 before a solve fails (undefined: the default; 0 shows the raw placement's error). */
+      setMaxConeRefinements(n: number | undefined): void;
+      /** Position of vertex `v` of the open mesh, its page position (client CSS px), the end vertices of edge `e`. */
+      vertexPosition(v: number): [number, number, number] | null;
+      projectVertex(v: number): { x: number; y: number } | null;
+      edgeEnds(e: number): [number, number] | null;
     };
   }
 }
@@ -42,7 +48,7 @@ declare global {
 const DEFAULT_SAMPLE = 'fandisk.obj';
 const hooks: Hooks = {
   state: 'idle', stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
-  features: 0, result: null, solveError: null, solves: 0, hoverFace: null,
+  features: 0, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
 };
 window.__conemap = hooks;
 document.body.dataset['state'] = hooks.state;
@@ -207,6 +213,12 @@ window.__conemapTest = {
     MeshWorker.helperMinFaces = minFaces;
     MeshWorker.helperWait = wait;
   },
+  setMaxConeRefinements: (n) => {
+    MeshWorker.maxConeRefinements = n;
+  },
+  vertexPosition: (v) => editor.vertexPosition(v),
+  projectVertex: (v) => editor.projectVertex(v),
+  edgeEnds: (e) => editor.edgeEnds(e),
 };
 
 void listSamples();

@@ -22,7 +22,7 @@ export type Request =
   | { id: number; type: 'sharp'; degrees: number; minEdges: number; closedOnly: boolean }
   // A solve in steps (so that a helper worker can place some components):
   // begin → place every component (here, or in a helper and then add) → finish.
-  | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean }
+  | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean; maxConeRefinements?: number | undefined }
   /** Places one component; with `share` the result answers `{ bytes }` for `solve-add` elsewhere. */
   | { id: number; type: 'solve-place'; component: number; share: boolean }
   | { id: number; type: 'solve-add'; bytes: Uint8Array }
@@ -161,6 +161,16 @@ export interface SharpResult {
   stats: { sharp_edges: number; curves: number; kept_edges: number; dropped_fragments: number; pruned_edges: number };
 }
 
+/**
+ * Where a solve error is on the mesh (crate `pipeline::ErrorLocation`), in the
+ * ids of the open mesh: the vertex named (or the corners of the edge / face a
+ * vertex was inserted in) and the edges named or to change (capped at 500).
+ */
+export interface ErrorLocation {
+  vertices: number[];
+  edges: number[];
+}
+
 export type Response =
   | { id: number; type: 'progress'; stage: string; step?: number; remaining?: number }
   | { id: number; type: 'result'; value: unknown }
@@ -170,4 +180,6 @@ export type Response =
       message: string;
       /** The wasm instance is unusable (trap/panic): the page must replace the worker. */
       fatal: boolean;
+      /** Where on the mesh, for solve errors that name mesh elements. */
+      location?: ErrorLocation;
     };

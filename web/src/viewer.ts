@@ -23,6 +23,7 @@ export const COLORS = {
   boundary: 0x2ec4b6,
   seam: 0xff4fa3,
   unaligned: 0xff1f1f, // requested features the map could not align
+  problem: 0xb6ff00, // where a solve failed: vertices (markers) and edges
   conePlus: 0xe63946, // k = +1 (angle deficit)
   coneMinus: 0x3a86ff, // k = −1 (angle excess)
   coneOther: 0xffd60a, // |k| > 1
@@ -166,6 +167,7 @@ export class Viewer {
   private readonly lineMaterials: LineMaterial[] = [];
   private markers = new THREE.Group();
   private anchor: THREE.Mesh | null = null;
+  private problemMarkers: THREE.InstancedMesh | null = null;
   private hover: THREE.Mesh | null = null;
   private uvMesh: THREE.Mesh | null = null;
   private mode: SurfaceMode = 'shaded';
@@ -397,6 +399,34 @@ export class Viewer {
     this.requestRender();
   }
 
+  /**
+   * Marks the vertices where a solve failed (spheres in COLORS.problem, drawn
+   * over the mesh so that they show through it); an empty list removes them.
+   */
+  setProblemVertices(vertices: ArrayLike<number>): void {
+    if (this.problemMarkers) {
+      this.group.remove(this.problemMarkers);
+      this.problemMarkers.geometry.dispose();
+      (this.problemMarkers.material as THREE.Material).dispose();
+      this.problemMarkers = null;
+    }
+    const n = this.data ? this.data.positions.length / 3 : 0;
+    const ids = Array.from(vertices).filter((v) => v < n);
+    if (ids.length > 0 && this.data) {
+      const box = this.mesh?.geometry.boundingBox;
+      const r = (box ? box.max.distanceTo(box.min) : 1) * 0.007;
+      const material = new THREE.MeshBasicMaterial({ color: COLORS.problem, depthTest: false, transparent: true, opacity: 0.9 });
+      const im = new THREE.InstancedMesh(new THREE.SphereGeometry(r, 16, 12), material, ids.length);
+      const p = this.data.positions;
+      const m = new THREE.Matrix4();
+      ids.forEach((v, i) => im.setMatrixAt(i, m.makeTranslation(p[3 * v]!, p[3 * v + 1]!, p[3 * v + 2]!)));
+      im.renderOrder = 11;
+      this.problemMarkers = im;
+      this.group.add(im);
+    }
+    this.requestRender();
+  }
+
   /** Highlights one face (hover sync with the UV view); null removes it. */
   setHoverFace(face: number | null): void {
     if (face === null || !this.data) {
@@ -472,18 +502,44 @@ export class Viewer {
   frame(): void {
     const sphere = this.mesh?.geometry.boundingSphere;
     if (!sphere) return;
-    const r = sphere.radius > 0 ? sphere.radius : 1;
+    this.look(sphere.center, sphere.radius, new THREE.Vector3(0.55, 0.4, 1).normalize());
+  }
+
+  /**
+   * Points the camera at the vertices `vertices` (ids of the shown mesh):
+   * their bounding sphere (at least 15 % of the mesh's, for some context)
+   * fills the view, seen from the side facing away from the mesh's centre.
+   * False when none is valid.
+   */
+  frameOn(vertices: ArrayLike<number>): boolean {
+    const sphere = this.mesh?.geometry.boundingSphere;
+    if (!sphere || !this.data) return false;
+    const p = this.data.positions;
+    const points: THREE.Vector3[] = [];
+    for (const v of Array.from(vertices)) if (v < p.length / 3) points.push(new THREE.Vector3(p[3 * v], p[3 * v + 1], p[3 * v + 2]));
+    if (points.length === 0) return false;
+    const around = new THREE.Sphere().setFromPoints(points);
+    const outward = around.center.clone().sub(sphere.center);
+    const dir = outward.length() > 1e-6 * sphere.radius ? outward.normalize() : this.camera.position.clone().sub(this.controls.target).normalize();
+    this.look(around.center, Math.max(around.radius, sphere.radius * 0.15), dir);
+    return true;
+  }
+
+  /** Camera at `center + dir * d` looking at `center`, `d` fitting a sphere of `radius` in the view; zoom limits from the whole mesh. */
+  private look(center: THREE.Vector3, radius: number, dir: THREE.Vector3): void {
     const fov = THREE.MathUtils.degToRad(this.camera.fov);
     const fit = Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * this.camera.aspect));
-    const distance = (r / Math.sin(fit / 2)) * 1.08;
-    const dir = new THREE.Vector3(0.55, 0.4, 1).normalize();
-    this.camera.position.copy(sphere.center).addScaledVector(dir, distance);
+    const fitting = (r: number): number => ((r > 0 ? r : 1) / Math.sin(fit / 2)) * 1.08;
+    const r = radius > 0 ? radius : 1;
+    const distance = fitting(r);
+    const whole = this.mesh?.geometry.boundingSphere?.radius || r;
+    this.camera.position.copy(center).addScaledVector(dir, distance);
     this.camera.near = distance / 100;
-    this.camera.far = distance * 10;
+    this.camera.far = Math.max(distance, fitting(whole)) * 10;
     this.camera.updateProjectionMatrix();
-    this.controls.target.copy(sphere.center);
-    this.controls.minDistance = r * 0.05;
-    this.controls.maxDistance = distance * 5;
+    this.controls.target.copy(center);
+    this.controls.minDistance = Math.min(r, whole) * 0.05;
+    this.controls.maxDistance = fitting(whole) * 5;
     this.controls.update();
     this.requestRender();
   }
@@ -493,6 +549,7 @@ export class Viewer {
     for (const name of [...this.lines.keys()]) this.setLines(name, new Uint32Array(0), [], 0);
     this.setCones([], []);
     this.setAnchor(null);
+    this.setProblemVertices([]);
     this.setHoverFace(null);
     for (const obj of [this.mesh, this.wire]) {
       if (!obj) continue;

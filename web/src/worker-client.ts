@@ -7,7 +7,7 @@
 // Solves run in steps (see protocol.ts): on large meshes a short-lived helper
 // worker opens the same mesh and places some of the cut mesh's components
 // (they are independent), which halves the cone stage on two cores.
-import type { ImportResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
+import type { ErrorLocation, ImportResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
 
 export class WorkerCrashed extends Error {
   override name = 'WorkerCrashed';
@@ -15,6 +15,17 @@ export class WorkerCrashed extends Error {
 
 export class Cancelled extends Error {
   override name = 'Cancelled';
+}
+
+/** A solve error that names mesh elements: `location` has their ids (see protocol.ts). */
+export class LocatedError extends Error {
+  override name = 'LocatedError';
+  constructor(
+    message: string,
+    readonly location: ErrorLocation,
+  ) {
+    super(message);
+  }
 }
 
 export type ProgressFn = (stage: string, step?: number, remaining?: number) => void;
@@ -41,6 +52,8 @@ export class MeshWorker {
   static helperMinFaces = 50_000;
   /** Test hook: the main worker waits until the helper is ready, so that both surely place components. */
   static helperWait = false;
+  /** Test hook: refinements around cones of angle 0 before a solve fails (undefined: the library's default). */
+  static maxConeRefinements: number | undefined = undefined;
 
   private worker: Worker;
   private nextId = 1;
@@ -127,7 +140,7 @@ export class MeshWorker {
           p.reject(new WorkerCrashed(msg.message));
           this.replace(new WorkerCrashed(msg.message));
         } else {
-          p.reject(new Error(msg.message));
+          p.reject(msg.location ? new LocatedError(msg.message, msg.location) : new Error(msg.message));
         }
         break;
     }
@@ -176,7 +189,7 @@ export class MeshWorker {
     const alive = (): void => {
       if (this.restarts !== generation) throw new Cancelled('cancelled');
     };
-    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq }, [], onProgress);
+    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq, maxConeRefinements: MeshWorker.maxConeRefinements }, [], onProgress);
     const queue = Array.from(schedule);
     const total = schedule.length;
     const helper = this.startHelper(features, alphaSmooth, miq, schedule);

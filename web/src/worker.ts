@@ -4,7 +4,7 @@
 // solves do not re-import it.
 import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView } from './protocol';
+import type { ErrorLocation, ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView } from './protocol';
 import { buildSolveView, viewBuffers } from './solve-view';
 import { buildAdjacency, faceEdges } from './topology';
 
@@ -30,6 +30,7 @@ interface Session {
   sharp_edges(degrees: number): Uint32Array;
   sharp_curves(degrees: number, minEdges: number, closedOnly: boolean): SharpResult;
   solve_begin(features: Uint32Array, alpha: number, miq: boolean): Uint32Array;
+  set_max_cone_refinements(n: number | undefined): void;
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
   solve_add(bytes: Uint8Array): void;
   solve_finish(progress: Progress): unknown;
@@ -47,6 +48,14 @@ function post(message: Response, transfer: Transferable[] = []): void {
 function errorMessage(e: unknown): string {
   if (e instanceof Error) return e.message || e.name;
   return String(e);
+}
+
+/** The `location` a solve error of the wasm carries (`{vertices, edges}`, see protocol.ts), or null. */
+function errorLocation(e: unknown): ErrorLocation | null {
+  const loc = (e as { location?: unknown } | null)?.location as Partial<ErrorLocation> | undefined;
+  const ids = (a: unknown): a is number[] => Array.isArray(a) && a.every((x) => Number.isInteger(x) && x >= 0);
+  if (!loc || !ids(loc.vertices) || !ids(loc.edges)) return null;
+  return { vertices: loc.vertices, edges: loc.edges };
 }
 
 function openMesh(req: Extract<Request, { type: 'import' }>): Answer {
@@ -123,6 +132,7 @@ function solveStep(req: Extract<Request, { type: 'solve-begin' | 'solve-place' |
   switch (req.type) {
     case 'solve-begin': {
       stepsStart = performance.now();
+      s.set_max_cone_refinements(req.maxConeRefinements);
       const schedule = s.solve_begin(req.features, req.alphaSmooth, req.miq);
       return { value: { schedule }, transfer: [schedule.buffer] };
     }
@@ -234,7 +244,8 @@ async function handle(req: Request): Promise<void> {
     const what = req.type === 'import' ? 'the importer' : 'the solver';
     const message = fatal ? `${what} crashed (${errorMessage(e)}); this is a bug in conemap` : errorMessage(e);
     if (fatal) session = null;
-    post({ id, type: 'error', message, fatal });
+    const location = fatal ? null : errorLocation(e);
+    post({ id, type: 'error', message, fatal, ...(location ? { location } : {}) });
   }
 }
 

@@ -342,7 +342,7 @@ fn cones_command(args: &Args) -> Result<(), Failure> {
     let mesh = load_mesh(file)?;
     let features = load_features(args, &mesh)?;
     let options = cone_options(args)?;
-    let solve_options = conemap::pipeline::SolveOptions { cones: options, param: conemap::param::ParamOptions::default() };
+    let solve_options = conemap::pipeline::SolveOptions { cones: options, ..Default::default() };
     let placed = conemap::pipeline::place_cones(&mesh, &features, &solve_options, &mut |_| {})
         .map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let (solved, result) = (placed.mesh(&mesh), &placed.placement);
@@ -414,7 +414,6 @@ fn solve(args: &Args) -> Result<(), Failure> {
     use conemap::export::{self, ExportInput, ExportOptions, Format};
     use conemap::io::{self, InputFile};
     use conemap::mesh::RawMesh;
-    use conemap::param::ParamOptions;
     use conemap::pipeline::{self, SolveOptions};
 
     let file = args.file()?;
@@ -450,7 +449,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
     let t_import = clock.lap();
 
     let features = load_features(args, &mesh)?;
-    let solve_options = SolveOptions { cones: options, param: ParamOptions::default() };
+    let solve_options = SolveOptions { cones: options, ..SolveOptions::default() };
     let solution = pipeline::solve(&mesh, &features, &solve_options, &mut |_| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let (placement, result) = (&solution.placement, &solution.param);
     let alignment = solution.feature_alignment(&mesh, &features);

@@ -110,16 +110,18 @@ pub enum ParamError {
     /// The mesh has no faces.
     EmptyMesh,
     /// A matching `m_e` of eq. (21) is not an integer (the connection is not
-    /// a cross-field connection): `value` quarter turns across original edge `edge`.
+    /// a cross-field connection): `value` quarter turns across edge `edge`.
+    /// (Indices in these variants are those of the mesh parametrized; see
+    /// `pipeline::SolveError::location` for the input mesh's.)
     NonIntegerMatching { edge: u32, value: f64 },
-    /// The field is not aligned with boundary/feature edge `edge` of the cut
-    /// mesh: `value` quarter turns off.
+    /// The field is not aligned with boundary/feature edge `edge` (opened
+    /// in the cut mesh): `value` quarter turns off.
     Misaligned { edge: u32, value: f64 },
     /// An edge outside the cut has a non-identity matching (bug guard).
     UncutSingularity { edge: u32, matching: i64 },
     /// The solve left a constraint row violated by `residual` (relative to the UV extent).
     ConstraintViolation { residual: f64 },
-    /// A cone of index `k >= 4` (cone angle `2 pi - k pi/2 <= 0`) at input vertex `vertex`:
+    /// A cone of index `k >= 4` (cone angle `2 pi - k pi/2 <= 0`) at vertex `vertex`:
     /// no seamless map exists with it.
     DegenerateCone { vertex: u32, k: i32 },
     /// A value became NaN or infinite.
