@@ -8,7 +8,7 @@
 
 use crate::clock::{now_seconds, Stopwatch};
 use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
-use crate::features::{refine_for_features, split_around, FeatureSet, RefineCounts, Refined, SplitReason};
+use crate::features::{refine_for_features, split_around, split_flipped, FeatureSet, RefineCounts, Refined};
 use crate::mesh::TriMesh;
 use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrization};
 use std::borrow::Cow;
@@ -127,7 +127,7 @@ pub struct Solution<'a> {
     pub original_edge: Option<Vec<u32>>,
     /// What the refinement split, by reason.
     pub refinement: RefineCounts,
-    /// Times the faces around flipped triangles were split and everything
+    /// Times the longest edges of flipped triangles were split and everything
     /// solved again ([`Placed::parametrize`]).
     pub flip_refinements: usize,
     pub placement: ConePlacement,
@@ -400,7 +400,7 @@ impl ConeStage {
         }
         // Only vertices of `m` are named; lift the refinement one level.
         let mut clock = Stopwatch::start();
-        let refined = Some(split_around(mesh, features, refined, &degenerate, SplitReason::ZeroAngleCone));
+        let refined = Some(split_around(mesh, features, refined, &degenerate));
         refine_seconds += clock.lap();
         Ok(ConeStep::Again(ConeStage::with_refinement(mesh, features, &options, refined, attempt + 1, refine_seconds, started)))
     }
@@ -418,8 +418,8 @@ impl Placed {
     }
 
     /// The seamless aligned parametrization (Appendix B) on the placed
-    /// cones. Where the map keeps flipped triangles, the faces around their
-    /// corners are split and the cones placed again, up to
+    /// cones. Where the map keeps flipped triangles, their longest edges are
+    /// split ([`split_flipped`]) and the cones placed again, up to
     /// `options.refine.max_flip_refinements` times; the result with the fewest flipped
     /// triangles is returned (a later attempt that fails is dropped).
     pub fn parametrize<'a>(
@@ -436,10 +436,7 @@ impl Placed {
                 break;
             }
             let mut clock = Stopwatch::start();
-            let mut corners: Vec<u32> = flipped.iter().flat_map(|&f| best.mesh.faces()[f as usize]).collect();
-            corners.sort_unstable();
-            corners.dedup();
-            let refined = split_around(mesh, features, best.refinement_of_input(), &corners, SplitReason::FlippedTriangle);
+            let refined = split_flipped(mesh, features, best.refinement_of_input(), &flipped);
             let started = now_seconds();
             let stage = ConeStage::with_refinement(mesh, features, &options, Some(refined), 0, best.refine_seconds + clock.lap(), started);
             let mut cone_progress = |p| progress(SolveProgress::Cones(p));

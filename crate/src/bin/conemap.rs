@@ -365,8 +365,8 @@ fn cones_command(args: &Args) -> Result<(), Failure> {
 fn refinement_note(splits: usize, r: &conemap::features::RefineCounts) -> String {
     format!(
         "inserted {splits} vertices ({} lone feature edges opened, {} triangles with three and {} with two constrained edges split, \
-         {} enclosed regions given an interior vertex, {} faces split around cones of angle 0, {} around flipped triangles)",
-        r.lone_edges, r.triply_constrained, r.doubly_constrained, r.enclosed_regions, r.zero_angle_faces, r.flipped_faces
+         {} enclosed regions given an interior vertex, {} faces split around cones of angle 0, {} long edges of flipped triangles split)",
+        r.lone_edges, r.triply_constrained, r.doubly_constrained, r.enclosed_regions, r.zero_angle_faces, r.flipped_edges
     )
 }
 

@@ -14,7 +14,7 @@ mod refine;
 
 pub use cut::{boundary_turning, cut_open, CutMesh};
 pub use detect::{detect_sharp, MinLength, SharpDetection, SharpOptions, SharpStats};
-pub use refine::{refine_for_features, split_around, RefineCounts, Refined, SplitReason};
+pub use refine::{refine_for_features, split_around, split_flipped, RefineCounts, Refined};
 
 use crate::mesh::TriMesh;
 use locate::VertexLocator;

@@ -40,17 +40,8 @@ pub struct RefineCounts {
     pub enclosed_regions: usize,
     /// Faces split at their centroid around vertices that needed a cone of angle 0.
     pub zero_angle_faces: usize,
-    /// Faces split at their centroid around the corners of triangles a map left flipped.
-    pub flipped_faces: usize,
-}
-
-/// Why [`split_around`] splits the faces around some vertices.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SplitReason {
-    /// The vertices needed a cone of index >= 4 (angle <= 0).
-    ZeroAngleCone,
-    /// The vertices are corners of triangles the map left flipped.
-    FlippedTriangle,
+    /// Longest edges of triangles a map left flipped, split at their midpoint.
+    pub flipped_edges: usize,
 }
 
 impl RefineCounts {
@@ -60,7 +51,7 @@ impl RefineCounts {
         self.doubly_constrained += o.doubly_constrained;
         self.enclosed_regions += o.enclosed_regions;
         self.zero_angle_faces += o.zero_angle_faces;
-        self.flipped_faces += o.flipped_faces;
+        self.flipped_edges += o.flipped_edges;
     }
 }
 
@@ -107,18 +98,39 @@ pub fn refine_for_features(mesh: &TriMesh, features: &FeatureSet) -> Option<Refi
 /// Splits every face around each vertex of `vertices` at its centroid
 /// (1 → 3), on top of the refinement `current` of `mesh` (if any): the
 /// inserted interior vertices can carry curvature a lone vertex cannot
-/// (a cone of index 4 has angle 0), and more freedom to unfold a flipped
-/// triangle. Features are kept; `reason` says which count the splits go to.
-pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, vertices: &[u32], reason: SplitReason) -> Refined {
+/// (a cone of index 4 has angle 0). Features are kept.
+pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, vertices: &[u32]) -> Refined {
     let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
     let mut plan = Splits::new(m);
     for &v in vertices {
         for face in m.vertex_faces(v) {
             if plan.centroid(face) {
-                match reason {
-                    SplitReason::ZeroAngleCone => plan.counts.zero_angle_faces += 1,
-                    SplitReason::FlippedTriangle => plan.counts.flipped_faces += 1,
-                }
+                plan.counts.zero_angle_faces += 1;
+            }
+        }
+    }
+    plan.apply(m, f, current.as_ref())
+}
+
+/// Splits the longest edge of each face of `faces` (a map left them
+/// flipped) at its midpoint, on top of the refinement `current` of `mesh`:
+/// a long edge between far-apart constrained vertices is what a coarse map
+/// cannot bend (a centroid keeps it). Faces beside an edge split in the same
+/// call are skipped. Features are kept (a split feature edge gives two).
+pub fn split_flipped(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, faces: &[u32]) -> Refined {
+    let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
+    let mut plan = Splits::new(m);
+    for &face in faces {
+        let longest = m.face_halfedges(face).into_iter().map(|h| m.edge(h)).max_by(|&a, &b| {
+            let length = |e: u32| {
+                let [u, w] = m.edge_vertices(e);
+                crate::vec3::norm(crate::vec3::sub(m.position(u), m.position(w)))
+            };
+            length(a).total_cmp(&length(b))
+        });
+        if let Some(e) = longest {
+            if plan.edge(m, e) {
+                plan.counts.flipped_edges += 1;
             }
         }
     }

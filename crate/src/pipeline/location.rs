@@ -332,7 +332,7 @@ mod tests {
         }
         let first = crate::features::refine_for_features(&m, &f).expect("the ring needs refinement");
         let corner = (0..first.mesh.n_vertices() as u32).find(|&v| first.mesh.position(v) == [1.0, 1.0, 0.0]).unwrap();
-        let r = crate::features::split_around(&m, &f, Some(first), &[corner], crate::features::SplitReason::ZeroAngleCone);
+        let r = crate::features::split_around(&m, &f, Some(first), &[corner]);
         assert!(r.mesh.n_vertices() > m.n_vertices());
         let lift = Lift {
             input: &m,
