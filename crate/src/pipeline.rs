@@ -287,9 +287,7 @@ pub fn place_cones(
     options: &SolveOptions,
     progress: &mut dyn FnMut(cones::Progress),
 ) -> Result<Placed, SolveError> {
-    let stage = ConeStage::new(mesh, features, options);
-    let results = cones::place_all(stage.problem(), progress).map_err(|e| stage.cone_error(mesh, features, e))?;
-    stage.complete(mesh, features, results, progress)
+    ConeStage::new(mesh, features, options).place(mesh, features, progress)
 }
 
 /// The cone stage of [`solve`] as steps, so that its components can be
@@ -360,6 +358,12 @@ impl ConeStage {
     /// located on the input `mesh` (with its `features`).
     pub fn cone_error(&self, mesh: &TriMesh, features: &FeatureSet, e: ConeError) -> SolveError {
         SolveError::new(&lift(mesh, features, self.refined.as_ref()), SolveCause::Cones(e))
+    }
+
+    /// Places every component here ([`cones::place_all`]) and completes the stage.
+    fn place(self, mesh: &TriMesh, features: &FeatureSet, progress: &mut dyn FnMut(cones::Progress)) -> Result<Placed, SolveError> {
+        let results = cones::place_all(self.problem(), progress).map_err(|e| self.cone_error(mesh, features, e))?;
+        self.complete(mesh, features, results, progress)
     }
 
     /// Joins the placed components (one per component of [`Self::problem`])
@@ -439,10 +443,8 @@ impl Placed {
             let refined = split_flipped(mesh, features, best.refinement_of_input(), &flipped);
             let started = now_seconds();
             let stage = ConeStage::with_refinement(mesh, features, &options, Some(refined), 0, best.refine_seconds + clock.lap(), started);
-            let mut cone_progress = |p| progress(SolveProgress::Cones(p));
-            let attempt = cones::place_all(stage.problem(), &mut cone_progress)
-                .map_err(|e| stage.cone_error(mesh, features, e))
-                .and_then(|results| stage.complete(mesh, features, results, &mut cone_progress))
+            let attempt = stage
+                .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
                 .and_then(|placed| placed.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p))));
             match attempt {
                 Ok(mut next) if next.param.metrics.flipped < best.param.metrics.flipped => {

@@ -40,12 +40,12 @@ pub fn midpoint(a: V3, b: V3) -> V3 {
 }
 
 /// Corners `(lo, hi)` of the axis-aligned box around `points` (infinite,
-/// inverted, for none).
-pub fn bounds(points: &[V3]) -> (V3, V3) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
+/// inverted, for none); points of any dimension (3D positions, 2D UVs).
+pub fn bounds<const N: usize>(points: &[[f64; N]]) -> ([f64; N], [f64; N]) {
+    let mut lo = [f64::INFINITY; N];
+    let mut hi = [f64::NEG_INFINITY; N];
     for p in points {
-        for i in 0..3 {
+        for i in 0..N {
             lo[i] = lo[i].min(p[i]);
             hi[i] = hi[i].max(p[i]);
         }

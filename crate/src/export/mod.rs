@@ -148,14 +148,7 @@ impl UvNormalization {
         if uv.is_empty() {
             return UvNormalization { offset: [0.0, 0.0], scale: 1.0 };
         }
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
-        for p in uv {
-            for i in 0..2 {
-                lo[i] = lo[i].min(p[i]);
-                hi[i] = hi[i].max(p[i]);
-            }
-        }
+        let (lo, hi) = crate::vec3::bounds(uv);
         let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
         let scale = if extent > 0.0 && extent.is_finite() { 1.0 / extent } else { 1.0 };
         UvNormalization { offset: lo, scale }
