@@ -173,6 +173,24 @@ impl Solution<'_> {
             .collect()
     }
 
+    /// Faces (of `mesh`) around the cones the map realized with another
+    /// index than placed ([`param::Parametrization::realized_cones`]): the
+    /// map is locally injective there, but the placement's angle did not fit.
+    pub fn realized_cone_faces(&self) -> Vec<u32> {
+        let cut = &self.placement.cut;
+        let mut faces: Vec<u32> =
+            self.param.realized_cones.iter().flat_map(|&(cv, _)| self.mesh.vertex_faces(cut.original_vertex[cv as usize])).collect();
+        faces.sort_unstable();
+        faces.dedup();
+        faces
+    }
+
+    /// Flipped triangles, then realized cones: what a flip refinement tries
+    /// to lower, in this order.
+    fn defects(&self) -> (usize, usize) {
+        (self.param.metrics.flipped, self.param.realized_cones.len())
+    }
+
     /// The refinement of the input this solution was computed on (`None`:
     /// the input itself), to refine further.
     fn refinement_of_input(&self) -> Option<Refined> {
@@ -422,10 +440,12 @@ impl Placed {
     }
 
     /// The seamless aligned parametrization (Appendix B) on the placed
-    /// cones. Where the map keeps flipped triangles, their longest edges are
-    /// split ([`split_flipped`]) and the cones placed again, up to
+    /// cones. Where the map keeps flipped triangles (else, where it realized
+    /// cones with another index than placed), their longest edges are split
+    /// ([`split_flipped`]) and the cones placed again, up to
     /// `options.refine.max_flip_refinements` times; the result with the fewest flipped
-    /// triangles is returned (a later attempt that fails is dropped).
+    /// triangles, then realized cones, is returned (a later attempt that
+    /// fails is dropped).
     pub fn parametrize<'a>(
         self,
         mesh: &'a TriMesh,
@@ -435,7 +455,10 @@ impl Placed {
         let options = self.options;
         let mut best = self.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p)))?;
         for _ in 0..options.refine.max_flip_refinements {
-            let flipped = best.flipped_faces();
+            let mut flipped = best.flipped_faces();
+            if flipped.is_empty() {
+                flipped = best.realized_cone_faces();
+            }
             if flipped.is_empty() {
                 break;
             }
@@ -447,7 +470,7 @@ impl Placed {
                 .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
                 .and_then(|placed| placed.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p))));
             match attempt {
-                Ok(mut next) if next.param.metrics.flipped < best.param.metrics.flipped => {
+                Ok(mut next) if next.defects() < best.defects() => {
                     next.flip_refinements = best.flip_refinements + 1;
                     best = next;
                 }
@@ -484,6 +507,8 @@ impl Placed {
             };
             SolveError::new(&lift, SolveCause::Param(e))
         })?;
+        let mut placement = placement;
+        placement.realize(&mesh, &param.realized_cones);
         Ok(Solution {
             mesh,
             features,

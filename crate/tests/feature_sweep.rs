@@ -133,6 +133,40 @@ fn a_fan_loop_that_folds_is_refined_until_fold_free() {
     assert!(solution.refinement.flipped_edges > 0);
 }
 
+/// The cow at `--sharp 90` without flip refinement: the fold-over repair
+/// leaves flipped triangles near clustered cones; the untangling
+/// (`param::untangle`) removes them, and the cones whose angle the map
+/// realizes differently (by a multiple of 2 pi) are what the solution
+/// reports: every interior vertex's UV angle sum is its reported cone angle,
+/// and the indices still sum to 4 chi.
+#[test]
+fn untangled_maps_report_the_cones_they_realize() {
+    use conemap::param::metrics::uv_angle_sums;
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let mesh = load("cow.obj");
+    let features = FeatureSet::sharp_edges(&mesh, 90.0);
+    let mut options = SolveOptions::default();
+    options.refine.max_flip_refinements = 0;
+    let solution = solve(&mesh, &features, &options, &mut |_| {}).expect("cow --sharp 90");
+    let m = &solution.param.metrics;
+    assert_eq!((m.flipped, m.wound_vertices), (0, 0));
+    assert!(solution.param.untangle_iterations > 0, "the repair alone leaves this map folded: untangling must have run");
+    assert!(!solution.param.realized_cones.is_empty(), "this map realizes some cones with another angle");
+    let solved = &*solution.mesh;
+    let on_feature = |v: u32| solved.outgoing(v).any(|h| solution.features.contains(solved.edge(h)));
+    let mut k = vec![0i32; solved.n_vertices()];
+    for c in &solution.placement.cones {
+        k[c.vertex as usize] = c.k;
+    }
+    let sums = uv_angle_sums(solved, &solution.param.uv);
+    for v in (0..solved.n_vertices() as u32).filter(|&v| !solved.is_boundary_vertex(v) && !on_feature(v)) {
+        let expected = 2.0 * PI - k[v as usize] as f64 * FRAC_PI_2;
+        assert!((sums[v as usize] - expected).abs() < 1e-6, "v{v}: UV angle sum {} but cone angle {expected}", sums[v as usize]);
+    }
+    let total: i64 = solution.placement.k.iter().map(|&k| k as i64).sum();
+    assert_eq!(total, 4 * solution.placement.cut.mesh.euler_characteristic(), "Gauss-Bonnet on the cut mesh");
+}
+
 mod random_features {
     //! Random feature sets (proptest, fixed seed): lone edges, random walks
     //! as curves and small loops around a vertex's fan, on meshes of three

@@ -491,6 +491,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
         report["flips_fixed"] = serde_json::json!(result.flips_fixed);
         report["repair_rounds"] = serde_json::json!(result.repair_rounds);
         report["refine_iterations"] = serde_json::json!(result.refine_iterations);
+        report["untangle_iterations"] = serde_json::json!(result.untangle_iterations);
         report["output"] = serde_json::json!({
             "path": out,
             "format": format!("{format:?}").to_ascii_lowercase(),

@@ -145,6 +145,27 @@ pub struct ConePlacement {
     pub timings: ConeTimings,
 }
 
+impl ConePlacement {
+    /// Sets the index of cut vertices to what a map realized (`(cut
+    /// vertex, k)` pairs, inside or on the cut mesh's boundary) and lists
+    /// the cones and corners again. A map realizes each angle up to
+    /// multiples of 2 pi (its angle sum at the vertex), so the indices change
+    /// by multiples of 4; with every triangle positive the angle sums add up
+    /// to pi per face, so the sum of the indices does not change
+    /// (Gauss-Bonnet, asserted in debug builds).
+    pub fn realize(&mut self, mesh: &TriMesh, realized: &[(u32, i32)]) {
+        if realized.is_empty() {
+            return;
+        }
+        let before: i64 = self.k.iter().map(|&k| k as i64).sum();
+        for &(v, k) in realized {
+            self.k[v as usize] = k;
+        }
+        debug_assert_eq!(before, self.k.iter().map(|&k| k as i64).sum::<i64>(), "realized cones must keep the index sum");
+        (self.cones, self.boundary_corners) = original_cones(mesh, &self.cut, &self.k);
+    }
+}
+
 /// Places cones on `mesh` with features `features` cut open (section 5).
 /// Natively the components are placed on two threads (they are independent);
 /// `progress` hears about the components placed on the calling thread.

@@ -154,25 +154,11 @@ impl Density {
     }
 }
 
-/// Jacobian of element `el` (rows: u and v gradients in the face frame) for
-/// the unknown vector `x`.
-fn jacobian(el: &Element, x: &[f64]) -> [[f64; 2]; 2] {
-    let mut j = [[0.0; 2]; 2];
-    for k in 0..3 {
-        for c in 0..2 {
-            let p = x[el.x[c][k]];
-            j[c][0] += p * el.g[k][0];
-            j[c][1] += p * el.g[k][1];
-        }
-    }
-    j
-}
-
 /// Total energy `E(x) = sum_f A_f psi(J_f)`; `inf` when a triangle is flipped or degenerate.
 pub(super) fn energy(elements: &[Element], x: &[f64], psi: &Density) -> f64 {
     let mut e = 0.0;
     for el in elements {
-        let d = psi.value(jacobian(el, x));
+        let d = psi.value(el.jacobian(x));
         if !d.is_finite() {
             return f64::INFINITY;
         }
@@ -293,7 +279,7 @@ impl<'a> Refiner<'a> {
             let mut rhs = vec![0.0; self.n + self.kkt.m];
             let mut proxy_ok = true;
             for (f, el) in self.elements.iter().enumerate() {
-                let j = jacobian(el, x);
+                let j = el.jacobian(x);
                 let Some((mm, rot, w_max)) = psi.proxy(j) else {
                     proxy_ok = false;
                     break;

@@ -2,8 +2,15 @@
 //! of B.1 ([`field`]), a cut to a topological disk through every cone
 //! ([`cut_graph`], B step 1), the seamless Poisson solve of eq. (23) followed
 //! by ARAP local/global iterations and a fold-over repair ([`seamless`]),
-//! an injective (flip-free) refinement under the same constraints
+//! the untangling of what the repair left flipped ([`untangle`]), an
+//! injective (flip-free) refinement under the same constraints
 //! ([`injective`]), and the quality figures of section 7 ([`metrics`], eq. 19).
+//!
+//! An untangled map has every triangle positive but may realize some cone
+//! angles differently from the placement (the placed angle plus a multiple
+//! of 2 pi: seam transitions only fix angles modulo 2 pi); those cones are
+//! returned in [`Parametrization::realized_cones`] and the pipeline reports
+//! them ([`ConePlacement::realize`]).
 //!
 //! Input: the original [`TriMesh`] and the [`ConePlacement`] computed on it.
 //! Output: one UV per face corner (`3 f + k`), seamless across every seam
@@ -15,6 +22,7 @@ pub mod field;
 pub mod injective;
 pub mod metrics;
 pub mod seamless;
+pub mod untangle;
 #[cfg(test)]
 mod tests;
 
@@ -46,11 +54,13 @@ pub struct ParamOptions {
     /// Injective refinement of the fold-free map ([`injective`]); 0
     /// iterations disables it.
     pub refine: injective::RefineOptions,
+    /// Untangling ([`untangle`]) of a map the repair left folded.
+    pub untangle: untangle::UntangleOptions,
 }
 
 impl Default for ParamOptions {
     fn default() -> Self {
-        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 60, refine: injective::RefineOptions::default() }
+        ParamOptions { max_arap_iterations: 100, arap_tolerance: 1e-5, fix_feature_rotations: true, repair_rounds: 60, refine: injective::RefineOptions::default(), untangle: untangle::UntangleOptions::default() }
     }
 }
 
@@ -76,6 +86,7 @@ pub struct ParamTimings {
     pub poisson: f64,
     pub arap: f64,
     pub repair: f64,
+    pub untangle: f64,
     pub injective: f64,
     pub metrics: f64,
 }
@@ -99,6 +110,12 @@ pub struct Parametrization {
     pub repair_rounds: usize,
     /// Iterations of the injective refinement kept (0: none ran or it was not used).
     pub refine_iterations: usize,
+    /// L-BFGS iterations of the untangling (0: the repair left no fold).
+    pub untangle_iterations: usize,
+    /// Cones the map realizes with another index than `placement` gave
+    /// them, `(cut vertex, k)`: apply with [`ConePlacement::realize`]. The
+    /// metrics already count the realized cones.
+    pub realized_cones: Vec<(u32, i32)>,
     pub timings: ParamTimings,
 }
 
@@ -201,7 +218,13 @@ pub fn parametrize(
     if uv.iter().any(|p| !p[0].is_finite() || !p[1].is_finite()) {
         return Err(ParamError::NotFinite { what: "uv" });
     }
-    let metrics = metrics::compute(mesh, placement, &cut, &uv);
+    let metrics = if result.realized.is_empty() {
+        metrics::compute(mesh, placement, &cut, &uv)
+    } else {
+        let mut realized = placement.clone();
+        realized.realize(mesh, &result.realized);
+        metrics::compute(mesh, &realized, &cut, &uv)
+    };
     timings.metrics = clock.lap();
     Ok(Parametrization {
         uv,
@@ -212,6 +235,8 @@ pub fn parametrize(
         flips_fixed: result.flips_fixed,
         repair_rounds: result.repair_rounds,
         refine_iterations: result.refine_iterations,
+        untangle_iterations: result.untangle_iterations,
+        realized_cones: result.realized,
         timings,
     })
 }

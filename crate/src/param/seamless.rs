@@ -10,6 +10,7 @@
 use super::cut_graph::CutGraph;
 use super::field::{CrossField, NO_ISOLINE};
 use super::injective::{RefineOptions, Refiner};
+use super::untangle::untangle;
 use super::metrics;
 use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
@@ -42,6 +43,11 @@ pub struct SeamlessResult {
     pub repair_rounds: usize,
     /// Iterations of the injective refinement ([`super::injective`]) kept.
     pub refine_iterations: usize,
+    /// L-BFGS iterations of the untangling ([`super::untangle`]).
+    pub untangle_iterations: usize,
+    /// Cones the map realizes with another index than placed: `(cut
+    /// vertex, k)` ([`ConePlacement::realize`]).
+    pub realized: Vec<(u32, i32)>,
     /// Final ARAP energy `sum_f A_f |J_f - R_f|^2`.
     pub energy: f64,
 }
@@ -55,6 +61,22 @@ pub(super) struct Element {
     /// Gradients of the three hat functions in the face frame.
     pub(super) g: [[f64; 2]; 3],
     pub(super) area: f64,
+}
+
+impl Element {
+    /// Jacobian (rows: u and v gradients in the face frame) for the unknown
+    /// vector `x`.
+    pub(super) fn jacobian(&self, x: &[f64]) -> [[f64; 2]; 2] {
+        let mut j = [[0.0; 2]; 2];
+        for k in 0..3 {
+            for c in 0..2 {
+                let p = x[self.x[c][k]];
+                j[c][0] += p * self.g[k][0];
+                j[c][1] += p * self.g[k][1];
+            }
+        }
+        j
+    }
 }
 
 /// The constrained system on the shared unknowns of [`unknowns`].
@@ -137,6 +159,23 @@ impl System {
             return Err(ParamError::ConstraintViolation { residual: worst / scale });
         }
         Ok((0..self.n_wedges).map(|w| [x[self.vars[0][w]], x[self.vars[1][w]]]).collect())
+    }
+
+    /// `q <- Z (Zᵀ A Z)⁻¹ Zᵀ q` with the factored KKT (`A` its current
+    /// stiffness, `Z` a basis of `C x = 0`): the KKT solve for right-hand
+    /// side `(q, 0)`, to a relative residual of 1e-8, projected onto the
+    /// constraints. Leaves `q` at 0 when the solve fails.
+    fn precondition(&self, q: &mut [f64]) {
+        let mut rhs = vec![0.0; self.n_unknowns + self.n_rows];
+        rhs[..self.n_unknowns].copy_from_slice(q);
+        let solved = self.solver().ok().and_then(|s| s.solve_many_to(&rhs, 1, 1e-8).ok());
+        match solved {
+            Some((x, ..)) => q.copy_from_slice(&x[..self.n_unknowns]),
+            None => q.iter_mut().for_each(|v| *v = 0.0),
+        }
+        if let Some(projector) = &self.projector {
+            projector.project(q, CONSTRAINT_TOLERANCE, 3);
+        }
     }
 
     fn refactor(&mut self, weights: &[f64]) -> Result<(), ParamError> {
@@ -224,20 +263,65 @@ pub(crate) fn interior_cone_angles(mesh: &TriMesh, placement: &ConePlacement) ->
     angle
 }
 
+/// The cones and boundary corners of a map with every triangle positive
+/// whose angle sum differs from the placement's (`2 pi - k pi/2` inside,
+/// `pi - k pi/2` on the cut mesh's boundary, i.e. features and boundaries):
+/// `(cut vertex, k)` with the index the sum realizes. Inside, seam
+/// transitions fix the angle up to multiples of 2 pi; on the boundary the
+/// edges are only held on isolines, so the angle may differ by multiples
+/// of pi/2 of the right parity (e.g. pi realized as 2 pi). Updates the
+/// interior `cone_angle` (per mesh vertex) to match. With every triangle
+/// positive the angle sums add up to `pi` per face, so the realized indices
+/// keep the placement's sum (`4 chi` of the cut mesh).
+fn realized_cones(placement: &ConePlacement, sys: &System, uv: &[[f64; 2]], cone_angle: &mut [f64]) -> Vec<(u32, i32)> {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let cm = &placement.cut.mesh;
+    let mut sums = vec![0.0; cm.n_vertices()];
+    for (f, tri) in cm.faces().iter().enumerate() {
+        let w = sys.elements[f].w;
+        for k in 0..3 {
+            sums[tri[k] as usize] += corner_angle(uv[w[k]], uv[w[(k + 1) % 3]], uv[w[(k + 2) % 3]]);
+        }
+    }
+    let mut out = Vec::new();
+    for (cv, &sum) in sums.iter().enumerate() {
+        let boundary = cm.is_boundary_vertex(cv as u32);
+        let full = if boundary { PI } else { 2.0 * PI };
+        let k = ((full - sum) / FRAC_PI_2).round() as i32;
+        if k != placement.k[cv] {
+            out.push((cv as u32, k));
+            if !boundary {
+                cone_angle[placement.cut.original_vertex[cv] as usize] = full - k as f64 * FRAC_PI_2;
+            }
+        }
+    }
+    out
+}
+
+/// Unsigned UV angle at corner `p` of the triangle `(p, a, b)`.
+fn corner_angle(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (x, y) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
+    (x[0] * y[1] - x[1] * y[0]).atan2(x[0] * y[0] + x[1] * y[1]).abs()
+}
+
+/// UV angle sum at every vertex of `mesh` (unsigned corner angles).
+fn wedge_angle_sums(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]]) -> Vec<f64> {
+    let mut sums = vec![0.0; mesh.n_vertices()];
+    for (f, tri) in mesh.faces().iter().enumerate() {
+        let w = sys.elements[f].w;
+        for k in 0..3 {
+            sums[tri[k] as usize] += corner_angle(uv[w[k]], uv[w[(k + 1) % 3]], uv[w[(k + 2) % 3]]);
+        }
+    }
+    sums
+}
+
 /// Flipped faces plus the faces around interior vertices whose UV angle sum
 /// is off their cone angle by more than pi: the map winds around such a
 /// vertex more than once although no triangle is flipped.
 fn folded_faces(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]], cone_angle: &[f64]) -> Vec<usize> {
     let mut bad = flipped_faces(sys, uv);
-    let mut sums = vec![0.0; mesh.n_vertices()];
-    for (f, tri) in mesh.faces().iter().enumerate() {
-        let w = sys.elements[f].w;
-        for k in 0..3 {
-            let (p, a, b) = (uv[w[k]], uv[w[(k + 1) % 3]], uv[w[(k + 2) % 3]]);
-            let (x, y) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
-            sums[tri[k] as usize] += (x[0] * y[1] - x[1] * y[0]).atan2(x[0] * y[0] + x[1] * y[1]).abs();
-        }
-    }
+    let sums = wedge_angle_sums(mesh, sys, uv);
     for v in 0..mesh.n_vertices() as u32 {
         let expected = cone_angle[v as usize];
         if expected.is_finite() && (sums[v as usize] - expected).abs() > std::f64::consts::PI {
@@ -318,7 +402,7 @@ pub fn solve(
 
     // Fold-over repair: raise the weight of flipped triangles and their
     // neighbours (keeps every constraint: only A changes), re-run ARAP.
-    let cone_angle = interior_cone_angles(mesh, placement);
+    let mut cone_angle = interior_cone_angles(mesh, placement);
     let mut flips = folded_faces(mesh, &sys, &uv, &cone_angle);
     let flips_before = flips.len();
     let (mut best_uv, mut best_flips) = (uv.clone(), flips.len());
@@ -380,6 +464,37 @@ pub fn solve(
     }
     timings.repair = clock.lap();
 
+    // Untangling of what the repair left folded, from its best map,
+    // preconditioned by the unweighted Poisson KKT (one factorization).
+    let (mut untangle_iterations, mut realized) = (0, Vec::new());
+    if best_flips > 0 && options.untangle.max_outer > 0 && sys.projector.is_some() {
+        weights.iter_mut().for_each(|w| *w = 1.0);
+        sys.refactor(&weights)?;
+        let precondition = |q: &mut [f64]| sys.precondition(q);
+        let mut x = sys.unknowns_of(&best_uv);
+        let stats = untangle(&sys.elements, &precondition, &mut x, &options.untangle);
+        untangle_iterations = stats.iterations;
+        if let Some(projector) = &sys.projector {
+            projector.project(&mut x, CONSTRAINT_TOLERANCE, 3);
+        }
+        let untangled = sys.wedges_of(&x);
+        let scale = x.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        let feasible = sys.constraint_residual(&x) <= 1e-12 * scale;
+        if feasible && stats.inverted == 0 && flipped_faces(&sys, &untangled).is_empty() {
+            // Every triangle positive: locally injective away from the cones,
+            // some of which the map may realize with another angle (its
+            // angle sum, the placed angle plus a multiple of 2 pi).
+            realized = realized_cones(placement, &sys, &untangled, &mut cone_angle);
+            best_flips = 0;
+            energy = arap_energy(&sys, &untangled);
+            best_uv = untangled;
+        }
+        // A partly untangled map is not kept: the flip refinement splits
+        // the faces the repair left flipped, and fewer of them there (a
+        // single one on teapot at `--sharp 20`) refine too little.
+    }
+    timings.untangle = clock.lap();
+
     // Injective refinement from a fold-free start: ARAP's map, else the
     // repaired one, else the Poisson map when that one is fold-free.
     if best_flips > 0 && folded_faces(mesh, &sys, &poisson_uv, &cone_angle).is_empty() {
@@ -414,6 +529,8 @@ pub fn solve(
         flips_fixed: flips_before - best_flips,
         repair_rounds: round,
         refine_iterations,
+        untangle_iterations,
+        realized,
         energy,
     })
 }
