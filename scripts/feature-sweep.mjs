@@ -6,7 +6,10 @@
 // rotation by k·90° (with equal lengths on both sides).
 //
 //   node scripts/feature-sweep.mjs [--angles 20,30,...] [--out DIR] MESH.obj ...
-// (CONEMAP_BIN=path runs another build of the CLI.)
+//   node scripts/feature-sweep.mjs --random N [--seed S] MESH.obj ...
+// (CONEMAP_BIN=path runs another build of the CLI.) With --random, each mesh
+// gets N random feature sets instead of thresholds, sent with --features:
+// lone edges, random walks along edges and loops around a vertex's fan.
 //
 // Prints one line per run and a summary; exits 1 when any run fails or is off.
 import { spawnSync } from 'node:child_process';
@@ -27,6 +30,8 @@ const take = (name, dflt) => {
 const angles = take('--angles', '20,30,40,50,60,70,80,90,100,110,120,130,140,150').split(',').map(Number);
 const outDir = take('--out', fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-sweep-')));
 const extra = take('--args', '').split(' ').filter(Boolean);
+const randomSets = Number(take('--random', '0'));
+let seed = Number(take('--seed', '1')) >>> 0;
 const bin = process.env.CONEMAP_BIN || path.join(root, 'target/release/conemap');
 fs.mkdirSync(outDir, { recursive: true });
 
@@ -127,33 +132,97 @@ function featureAlignment(out, edges) {
   return { worst, off, missing };
 }
 
+/** Deterministic uniform [0, 1) (mulberry32). */
+function random() {
+  seed = (seed + 0x6d2b79f5) >>> 0;
+  let t = seed;
+  t = Math.imul(t ^ (t >>> 15), t | 1);
+  t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
+  return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+}
+
+/**
+ * A random feature set of `mesh` as position-pair keys: 1-6 picks, each a
+ * lone interior edge, a random walk of 2-30 edges or the loop of edges
+ * around a vertex's fan (the edges opposite it).
+ */
+function randomFeatures({ v, faces }) {
+  const key = (i) => v[i].join(',');
+  const nbrs = new Map();
+  const opposite = new Map();
+  const edgeKey = (a, b) => (a < b ? `${a}|${b}` : `${b}|${a}`);
+  for (const f of faces) {
+    for (let k = 0; k < 3; k++) {
+      const [a, b, c] = [key(f[k][0]), key(f[(k + 1) % 3][0]), key(f[(k + 2) % 3][0])];
+      if (!nbrs.has(a)) nbrs.set(a, new Set());
+      nbrs.get(a).add(b);
+      if (!nbrs.has(b)) nbrs.set(b, new Set());
+      nbrs.get(b).add(a);
+      if (!opposite.has(a)) opposite.set(a, []);
+      opposite.get(a).push(edgeKey(b, c));
+    }
+  }
+  const vertices = [...nbrs.keys()];
+  const pickVertex = () => vertices[Math.floor(random() * vertices.length)];
+  const out = new Set();
+  const picks = 1 + Math.floor(random() * 6);
+  for (let p = 0; p < picks; p++) {
+    const kind = Math.floor(random() * 3);
+    let at = pickVertex();
+    if (kind === 2) {
+      for (const e of opposite.get(at)) out.add(e);
+      continue;
+    }
+    const steps = kind === 0 ? 1 : 2 + Math.floor(random() * 29);
+    for (let s = 0; s < steps; s++) {
+      const next = [...nbrs.get(at)];
+      const to = next[Math.floor(random() * next.length)];
+      out.add(edgeKey(at, to));
+      at = to;
+    }
+  }
+  return out;
+}
+
 let failures = 0;
 const rows = [];
 for (const mesh of argv) {
   const input = parseObj(fs.readFileSync(mesh, 'utf8'));
   const name = path.basename(mesh, '.obj');
-  for (const deg of angles) {
+  const runs = randomSets > 0 ? [...Array(randomSets).keys()].map((i) => `#${i}`) : angles;
+  for (const deg of runs) {
     const obj = path.join(outDir, `${name}-${deg}.obj`);
     const report = path.join(outDir, `${name}-${deg}.json`);
+    let sharp;
+    let args;
+    if (randomSets > 0) {
+      sharp = randomFeatures(input);
+      const file = path.join(outDir, `${name}-${deg}.features.json`);
+      const edges = [...sharp].map((e) => e.split('|').map((p) => p.split(',').map(Number)));
+      fs.writeFileSync(file, JSON.stringify({ edges }));
+      args = ['--features', file];
+    } else {
+      sharp = sharpEdges(input, deg);
+      args = ['--sharp', String(deg)];
+    }
     const t0 = Date.now();
-    const run = spawnSync(bin, ['solve', mesh, '-o', obj, '--sharp', String(deg), '--report', report, ...extra], { encoding: 'utf8' });
+    const run = spawnSync(bin, ['solve', mesh, '-o', obj, ...args, '--report', report, ...extra], { encoding: 'utf8' });
     const secs = ((Date.now() - t0) / 1000).toFixed(1);
     if (run.status !== 0) {
       failures += 1;
       const msg = run.stderr.trim().split('\n').pop();
-      console.log(`${name} ${deg}°: FAILED (${secs} s) ${msg}`);
+      console.log(`${name} ${deg}${randomSets ? '' : '°'}: FAILED (${secs} s) ${msg}`);
       rows.push({ name, deg, ok: false, msg });
       continue;
     }
     const out = parseObj(fs.readFileSync(obj, 'utf8'));
-    const sharp = sharpEdges(input, deg);
     const uv = checkUv(out);
     const al = featureAlignment(out, sharp);
     const rep = JSON.parse(fs.readFileSync(report, 'utf8'));
     const bad = uv.flipped > 0 || uv.maxSeamAngle > 1e-9 || uv.maxSeamLength > 1e-6 || al.worst > 1e-9 || al.missing > 0;
     const unaligned = rep.unaligned_features?.length ?? 0;
     if (bad && !(al.off <= unaligned && uv.flipped === 0)) failures += 1;
-    const line = `${name} ${deg}°: ${bad ? 'OFF' : 'ok'} (${secs} s) features ${sharp.size}, cones ${rep.cones.length}, flipped ${uv.flipped}, seam ${uv.maxSeamAngle.toExponential(1)} rad / ${uv.maxSeamLength.toExponential(1)}, features off ${al.off} (worst ${al.worst.toExponential(1)} rad, reported ${unaligned}), missing ${al.missing}, distortion ${rep.metrics.distortion.toFixed(4)}, inserted ${rep.inserted_vertices}`;
+    const line = `${name} ${deg}${randomSets ? '' : '°'}: ${bad ? 'OFF' : 'ok'} (${secs} s) features ${sharp.size}, cones ${rep.cones.length}, flipped ${uv.flipped}, seam ${uv.maxSeamAngle.toExponential(1)} rad / ${uv.maxSeamLength.toExponential(1)}, features off ${al.off} (worst ${al.worst.toExponential(1)} rad, reported ${unaligned}), missing ${al.missing}, distortion ${rep.metrics.distortion.toFixed(4)}, inserted ${rep.inserted_vertices}`;
     console.log(line);
     rows.push({ name, deg, ok: !bad, secs: +secs, features: sharp.size, flipped: uv.flipped, seam: uv.maxSeamAngle, off: al.off, worst: al.worst, distortion: rep.metrics.distortion });
   }

@@ -29,24 +29,25 @@ impl<'a> VertexLocator<'a> {
         [0, 1, 2].map(|i| ((p[i] - self.origin[i]) / self.cell).floor() as i64)
     }
 
-    /// The nearest vertex within the tolerance, if any.
-    pub(super) fn find(&self, p: &[f64; 3]) -> Option<u32> {
+    /// Every vertex within the tolerance, nearest first (a mesh can hold
+    /// several vertices at one position: open cracks, touching components).
+    pub(super) fn find_all(&self, p: &[f64; 3]) -> Vec<u32> {
         let k = self.key(p);
-        let mut best: Option<(f64, u32)> = None;
+        let mut near: Vec<(f64, u32)> = Vec::new();
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
                     for &v in self.grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]).into_iter().flatten() {
                         let q = self.positions[v as usize];
                         let d = ((0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>()).sqrt();
-                        if d <= self.tolerance && best.is_none_or(|(bd, _)| d < bd) {
-                            best = Some((d, v));
+                        if d <= self.tolerance {
+                            near.push((d, v));
                         }
                     }
                 }
             }
         }
-        best.map(|(_, v)| v)
+        near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        near.into_iter().map(|(_, v)| v).collect()
     }
 }
-

@@ -70,13 +70,17 @@ impl FeatureSet {
         let locator = VertexLocator::new(mesh.positions());
         let mut set = FeatureSet::none(mesh);
         for (index, [p, q]) in edges.iter().enumerate() {
-            let find = |x: &[f64; 3]| locator.find(x).ok_or(FeatureError::NoVertexAt { index, position: *x });
-            let (a, b) = (find(p)?, find(q)?);
-            let e = mesh
-                .outgoing(a)
-                .find(|&h| mesh.head(h) == b)
-                .map(|h| mesh.edge(h))
-                .ok_or(FeatureError::NotAnEdge { index, vertices: [a, b] })?;
+            let find = |x: &[f64; 3]| {
+                let near = locator.find_all(x);
+                if near.is_empty() { Err(FeatureError::NoVertexAt { index, position: *x }) } else { Ok(near) }
+            };
+            let (ends_p, ends_q) = (find(p)?, find(q)?);
+            // Of the vertices at each end, the (nearest) pair joined by an edge.
+            let e = ends_p
+                .iter()
+                .flat_map(|&a| ends_q.iter().map(move |&b| (a, b)))
+                .find_map(|(a, b)| mesh.outgoing(a).find(|&h| mesh.head(h) == b).map(|h| mesh.edge(h)))
+                .ok_or(FeatureError::NotAnEdge { index, vertices: [ends_p[0], ends_q[0]] })?;
             set.set(mesh, e, true);
         }
         Ok(set)
@@ -218,5 +222,21 @@ mod tests {
         assert!(matches!(far, Err(FeatureError::NoVertexAt { index: 0, .. })));
         let diagonal = FeatureSet::from_positions(&m, &[[[0., 0., 0.], [1., 1., 1.]]]);
         assert!(matches!(diagonal, Err(FeatureError::NotAnEdge { index: 0, .. })));
+    }
+
+    #[test]
+    fn features_by_position_find_the_edge_among_coincident_vertices() {
+        // A cube and a closed tetrahedron touching it at the cube's corner
+        // (0, 0, 0) with a vertex of its own there (vertices 0 and 8).
+        let c = cube();
+        let mut p = c.positions().to_vec();
+        p.extend([[0., 0., 0.], [-1., 0., 0.], [0., -1., 0.], [0., 0., -1.]]);
+        let mut tris = c.faces().to_vec();
+        tris.extend([[8, 10, 9], [8, 9, 11], [8, 11, 10], [9, 10, 11]]);
+        let m = TriMesh::from_welded_arrays(p, tris).unwrap();
+        for edge in [[[0., 0., 0.], [-1., 0., 0.]], [[1., 0., 0.], [0., 0., 0.]]] {
+            let s = FeatureSet::from_positions(&m, &[edge]).expect("the edge exists at one of the coincident vertices");
+            assert_eq!(s.len(), 1);
+        }
     }
 }
