@@ -288,6 +288,7 @@ impl MeshSession {
         set(&out, "inserted_vertices", &(sol.splits as f64).into())?;
         set(&out, "refinement", &to_js(&sol.refinement)?)?;
         set(&out, "flip_refinements", &(sol.flip_refinements as f64).into())?;
+        set(&out, "realized_cones", &(sol.param.realized_cones.len() as f64).into())?;
         set(&out, "feature_alignment", &to_js(&sol.feature_alignment(mesh, features))?)?;
         // Exports of the solved mesh (with any split edges), exactly.
         let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };

@@ -492,6 +492,7 @@ fn solve(args: &Args) -> Result<(), Failure> {
         report["repair_rounds"] = serde_json::json!(result.repair_rounds);
         report["refine_iterations"] = serde_json::json!(result.refine_iterations);
         report["untangle_iterations"] = serde_json::json!(result.untangle_iterations);
+        report["realized_cones"] = serde_json::json!(result.realized_cones.len());
         report["output"] = serde_json::json!({
             "path": out,
             "format": format!("{format:?}").to_ascii_lowercase(),
@@ -543,6 +544,12 @@ fn solve(args: &Args) -> Result<(), Failure> {
     }
     if solution.splits > 0 {
         println!("  note: {}; the output is the refined mesh", refinement_note(solution.splits, &solution.refinement));
+    }
+    if !result.realized_cones.is_empty() {
+        println!(
+            "  note: {} cones and corners came out with another angle than placed (the untangled map realizes them); listed as realized",
+            result.realized_cones.len()
+        );
     }
     for note in input.notes() {
         println!("  note: {note}");
