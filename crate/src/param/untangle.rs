@@ -14,9 +14,12 @@
 //! start from a folded map; `eps` is lowered between minimisations by the
 //! paper's rule until every `D > 0`, after which the barrier is the one of
 //! [`super::injective`]. Each minimisation is L-BFGS on the null space of
-//! the constraints: gradients are projected orthogonally onto `C x = 0`, so
-//! every direction (a combination of projected gradients and past steps)
-//! keeps the iterate feasible.
+//! the constraints, its initial inverse Hessian the constrained Poisson
+//! inverse `Z (Zᵀ A Z)⁻¹ Zᵀ` (`Z` a basis of `C x = 0`; one solve with the
+//! factored KKT): every direction, a combination of such solves and past
+//! steps, keeps the iterate feasible, and the Poisson part scales the steps
+//! to the mesh (with projected gradients alone L-BFGS made little progress
+//! on the cow).
 
 use super::seamless::Element;
 
