@@ -6,11 +6,13 @@
 //! injective (flip-free) refinement under the same constraints
 //! ([`injective`]), and the quality figures of section 7 ([`metrics`], eq. 19).
 //!
-//! An untangled map has every triangle positive but may realize some cone
-//! angles differently from the placement (the placed angle plus a multiple
-//! of 2 pi: seam transitions only fix angles modulo 2 pi); those cones are
-//! returned in [`Parametrization::realized_cones`] and the pipeline reports
-//! them ([`ConePlacement::realize`]).
+//! An untangled map has every triangle positive but may realize some
+//! angles differently from the placement: inside, the placed cone angle
+//! plus a multiple of 2 pi (seam transitions fix angles modulo 2 pi only);
+//! on features and boundaries any multiple of pi/2 of the same parity.
+//! Those cones and corners are returned in
+//! [`Parametrization::realized_cones`] and the pipeline reports them
+//! ([`ConePlacement::realize`]).
 //!
 //! Input: the original [`TriMesh`] and the [`ConePlacement`] computed on it.
 //! Output: one UV per face corner (`3 f + k`), seamless across every seam
