@@ -87,14 +87,16 @@ pub fn uv_angle_sums(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<f64> {
     let mut sums = vec![0.0; mesh.n_vertices()];
     for (f, t) in mesh.faces().iter().enumerate() {
         for k in 0..3 {
-            let p = uv[3 * f + k];
-            let a = uv[3 * f + (k + 1) % 3];
-            let b = uv[3 * f + (k + 2) % 3];
-            let (u, v) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
-            sums[t[k] as usize] += (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1]).abs();
+            sums[t[k] as usize] += corner_angle(uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
         }
     }
     sums
+}
+
+/// Unsigned UV angle at corner `p` of the triangle `(p, a, b)`.
+pub(super) fn corner_angle(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (x, y) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
+    (x[0] * y[1] - x[1] * y[0]).atan2(x[0] * y[0] + x[1] * y[1]).abs()
 }
 
 /// Angle (radians) from `angle` to the nearest multiple of 90°.

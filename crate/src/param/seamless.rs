@@ -11,7 +11,7 @@ use super::cut_graph::CutGraph;
 use super::field::{CrossField, NO_ISOLINE};
 use super::injective::{RefineOptions, Refiner};
 use super::untangle::untangle;
-use super::metrics;
+use super::metrics::{self, corner_angle};
 use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
@@ -298,12 +298,6 @@ fn realized_cones(placement: &ConePlacement, sys: &System, uv: &[[f64; 2]], cone
     out
 }
 
-/// Unsigned UV angle at corner `p` of the triangle `(p, a, b)`.
-fn corner_angle(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (x, y) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
-    (x[0] * y[1] - x[1] * y[0]).atan2(x[0] * y[0] + x[1] * y[1]).abs()
-}
-
 /// UV angle sum at every vertex of `mesh` (unsigned corner angles).
 fn wedge_angle_sums(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]]) -> Vec<f64> {
     let mut sums = vec![0.0; mesh.n_vertices()];
@@ -481,9 +475,9 @@ pub fn solve(
         let scale = x.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         let feasible = sys.constraint_residual(&x) <= 1e-12 * scale;
         if feasible && stats.inverted == 0 && flipped_faces(&sys, &untangled).is_empty() {
-            // Every triangle positive: locally injective away from the cones,
-            // some of which the map may realize with another angle (its
-            // angle sum, the placed angle plus a multiple of 2 pi).
+            // Every triangle positive: locally injective away from the cones
+            // and corners, some of which the map may realize with another
+            // angle than placed (see `realized_cones`).
             realized = realized_cones(placement, &sys, &untangled, &mut cone_angle);
             best_flips = 0;
             energy = arap_energy(&sys, &untangled);
