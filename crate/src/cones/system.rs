@@ -24,7 +24,10 @@ use crate::vec3;
 use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::PI;
 
+mod curvature;
 mod moves;
+
+use curvature::CurvatureSystem;
 
 /// Weight of the harmonic norm in the lexicographic objective.
 const HARMONIC_WEIGHT: f64 = 1e4;
@@ -104,6 +107,13 @@ pub struct ComponentSystem<'a> {
     pub refinement_steps: usize,
     /// Upper-triangle triplets of the objective's phi and h blocks.
     objective_terms: Vec<Triplet>,
+    /// Upper-triangle triplets of `L` on the local vertices.
+    laplacian: Vec<Triplet>,
+    /// The path rows' entries on `[phi | h~]` (rows from 0).
+    path_rows: Vec<Triplet>,
+    /// The curvature equation alone, for trials once every `p` is fixed
+    /// (built on first use).
+    curvature: Option<CurvatureSystem>,
 }
 
 /// What went wrong while placing cones.
@@ -237,14 +247,18 @@ impl<'a> ComponentSystem<'a> {
         let h_scale = if weights.miq { 1.0 } else { HARMONIC_WEIGHT.sqrt() };
         let (p0, h0) = (nv + nh, nv);
         let mut a: Vec<Triplet> = Vec::new();
-        let l = crate::operators::cotan_laplacian_triplets(mesh.positions(), mesh.faces());
+        // L on the component's faces (in mesh order, as summed before).
+        let mut component_faces = tree.faces.clone();
+        component_faces.sort_unstable();
+        let triangles: Vec<[u32; 3]> = component_faces.iter().map(|&f| mesh.faces()[f as usize]).collect();
+        let l = crate::operators::cotan_laplacian_triplets(mesh.positions(), &triangles);
+        let laplacian: Vec<Triplet> = l
+            .iter()
+            .map(|&(r, c, w)| (local[r] as usize, local[c] as usize, w))
+            .filter(|&(lr, lc, _)| lr <= lc)
+            .collect();
         let alpha = weights.alpha_smooth;
-        for &(r, c, w) in &l {
-            let (lr, lc) = (local[r] as usize, local[c] as usize);
-            if (lr as u32) != NONE && lr <= lc {
-                a.push((lr, lc, alpha * w));
-            }
-        }
+        a.extend(laplacian.iter().map(|&(r, c, w)| (r, c, alpha * w)));
         for i in 0..nv {
             a.push((i, i, area[i] / total_area));
         }
@@ -280,6 +294,8 @@ impl<'a> ComponentSystem<'a> {
         }
         row += nv.saturating_sub(1);
         // Path rows.
+        let path_start = c.len();
+        let row_path = row;
         for &e in &tree.leftovers {
             let cycle = tree.fundamental_cycle(mesh, e);
             for visit in &cycle {
@@ -296,6 +312,7 @@ impl<'a> ComponentSystem<'a> {
             rhs.push(-frames.cycle_transport(mesh, &cycle));
             row += 1;
         }
+        let path_rows: Vec<Triplet> = c[path_start..].iter().map(|&(r, col, w)| (r - row_path, col, w)).collect();
         // Fix rows.
         let row_fix = row;
         for g in 0..ng {
@@ -343,6 +360,9 @@ impl<'a> ComponentSystem<'a> {
             rounds: 0,
             refinement_steps: 0,
             objective_terms,
+            laplacian,
+            path_rows,
+            curvature: None,
         })
     }
 
@@ -467,16 +487,6 @@ impl<'a> ComponentSystem<'a> {
         // factorization of the final matrix.
         if self.border.is_empty() {
             self.solve()
-        } else {
-            self.refactor_and_solve()
-        }
-    }
-
-    /// Refactorizes if bordered fixes are pending, so that the factor holds
-    /// the current matrix (needed by plain factor solves).
-    fn settle_border(&mut self) -> Result<(), ConeError> {
-        if self.border.is_empty() {
-            Ok(())
         } else {
             self.refactor_and_solve()
         }

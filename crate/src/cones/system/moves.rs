@@ -7,8 +7,8 @@
 //! factorization (no refactorization, no re-solve of `x`), and many trials
 //! share one blocked solve.
 
-use super::{ComponentSystem, ConeError, BORDER_BUDGET};
-use crate::mesh::NONE;
+use super::{ComponentSystem, ConeError, CurvatureSystem, BORDER_BUDGET};
+use std::f64::consts::FRAC_PI_2;
 
 /// A transfer of cone index: `(from, to, amount)` in local vertices and
 /// quarter turns.
@@ -58,31 +58,42 @@ impl ComponentSystem<'_> {
         }
     }
 
-    /// For each set of transfers, the change of the solution `x` that making
-    /// them all would bring (column-major, one column of `K`'s dimension per set).
+    /// The curvature system of the final integers (factorized on first use).
+    fn curvature(&mut self) -> Result<&CurvatureSystem, ConeError> {
+        if self.curvature.is_none() {
+            let mass: Vec<f64> = self.area.iter().map(|a| a / self.total_area).collect();
+            let nh = self.basis.len();
+            self.curvature = Some(CurvatureSystem::new(&self.laplacian, mass, &self.path_rows, nh)?);
+        }
+        Ok(self.curvature.as_ref().expect("built above"))
+    }
+
+    /// Width of a response column: `phi` then `h~` (the objective's unknowns).
+    fn response_width(&self) -> usize {
+        self.tree.vertices.len() + self.basis.len()
+    }
+
+    /// For each set of transfers, the change of `[phi; h~]` that making them
+    /// all would bring (column-major, [`Self::response_width`] per set).
     fn responses(&mut self, sets: &[Vec<Transfer>]) -> Result<Vec<f64>, ConeError> {
-        self.settle_border()?;
-        let dim = self.kkt.pattern.dim();
-        let fix0 = self.n + self.row_fix;
-        let mut rhs = vec![0.0; dim * sets.len()];
+        let nv = self.tree.vertices.len();
+        let mut db = vec![0.0; nv * sets.len()];
         for (col, set) in sets.iter().enumerate() {
-            for &t in set {
-                for (g, dp) in self.transfer_changes(t) {
-                    rhs[col * dim + fix0 + g] += dp as f64;
-                }
+            for &(from, to, amount) in set {
+                db[col * nv + to] += FRAC_PI_2 * amount as f64;
+                db[col * nv + from] -= FRAC_PI_2 * amount as f64;
             }
         }
-        let (dx, info) = self.solver.solve_many_to(&rhs, sets.len(), TRIAL_TOLERANCE)?;
-        self.refinement_steps += info.iter().map(|i| i.refinement_steps).sum::<usize>();
-        Ok(dx)
+        Ok(self.curvature()?.responses(&db, sets.len(), TRIAL_TOLERANCE)?)
     }
 
     /// Trial columns per blocked solve within the memory budget.
     fn trial_columns(&self) -> usize {
-        MAX_TRIAL_COLUMNS.min(BORDER_BUDGET / self.kkt.pattern.dim().max(1)).max(1)
+        MAX_TRIAL_COLUMNS.min(BORDER_BUDGET / self.response_width().max(1)).max(1)
     }
 
-    /// Makes the transfers and moves `x` by their response `dx`.
+    /// Makes the transfers and moves `[phi; h~]` by their response `dx`;
+    /// the rest of `x` is stale until the next [`Self::solve`].
     fn accept(&mut self, transfers: &[Transfer], dx: &[f64]) {
         for &t in transfers {
             self.transfer(t);
@@ -93,31 +104,11 @@ impl ComponentSystem<'_> {
     /// First-order sensitivity of `phiᵀ M phi / A` to moving cone index:
     /// returns `Phi` per local vertex such that moving `a` quarter turns from
     /// `u` to `w` (along `T_p`, as [`Self::transfer`] does) changes the
-    /// energy by about `2 a (Phi[w] - Phi[u])`. One solve with the current
-    /// factorization: `y = K⁻¹ [D phi; 0]`, read on the fix rows.
+    /// energy by about `2 a (Phi[w] - Phi[u])` (one curvature solve).
     fn move_potential(&mut self) -> Result<Vec<f64>, ConeError> {
-        self.settle_border()?;
-        let nv = self.tree.vertices.len();
-        let mut r = vec![0.0; self.n + self.constraint_rhs.len()];
-        for ((ri, a), x) in r.iter_mut().zip(&self.area).zip(&self.x) {
-            *ri = a / self.total_area * x;
-        }
+        let phi = self.x[..self.tree.vertices.len()].to_vec();
         // A ranking needs no more than the trials' accuracy.
-        let y = self.solver.solve_many_to(&r, 1, TRIAL_TOLERANCE)?.0;
-        let mut order: Vec<usize> = (0..nv).collect();
-        order.sort_by_key(|&i| self.tree.primal_depth[self.tree.vertices[i] as usize]);
-        let mut phi = vec![0.0; nv];
-        for i in order {
-            let h = self.tree.primal_parent_he[self.tree.vertices[i] as usize];
-            if h == NONE {
-                continue; // the root of T_p
-            }
-            let parent = self.local[self.mesh.tail(h) as usize] as usize;
-            let g = self.tree.g_index[self.mesh.edge(h) as usize];
-            let sigma = self.sigma(i, g).unwrap_or(0);
-            phi[i] = phi[parent] + y[self.n + self.row_fix + g as usize] * sigma as f64;
-        }
-        Ok(phi)
+        Ok(self.curvature()?.move_potential(&phi, TRIAL_TOLERANCE)?)
     }
 
     /// Cone-location optimization (section 5.3): moves an interior cone to
@@ -167,7 +158,7 @@ impl ComponentSystem<'_> {
                 let sets: Vec<Vec<Transfer>> =
                     chunk.iter().flat_map(|(i, ki, js)| js.iter().map(move |&j| vec![(*i, j, *ki)])).collect();
                 let dx = self.responses(&sets)?;
-                let dim = self.kkt.pattern.dim();
+                let dim = self.response_width();
                 let mut first = 0;
                 for (i, ki, js) in chunk {
                     let (i, start) = (*i, first);
@@ -227,7 +218,7 @@ impl ComponentSystem<'_> {
     /// quarter turns moved.
     pub fn spread_degenerate_cones(&mut self) -> Result<usize, ConeError> {
         let mut moved = 0;
-        let dim = self.kkt.pattern.dim();
+        let dim = self.response_width();
         while let Some((i, _)) = self.interior_cones().into_iter().find(|&(_, k)| k > MAX_CONE_INDEX) {
             let v = self.tree.vertices[i];
             let mut near: Vec<u32> = self.mesh.one_ring(v).flat_map(|a| self.mesh.one_ring(a).chain([a])).collect();
@@ -368,7 +359,7 @@ impl ComponentSystem<'_> {
                 trials.extend(partners.iter().take(nearest).map(|&(_, j)| (i, j, ki)));
             }
             let mut best: Option<(f64, Transfer, Vec<f64>)> = None;
-            let dim = self.kkt.pattern.dim();
+            let dim = self.response_width();
             for chunk in trials.chunks(self.trial_columns()) {
                 let sets: Vec<Vec<Transfer>> = chunk.iter().map(|&t| vec![t]).collect();
                 let dx = self.responses(&sets)?;
@@ -391,5 +382,50 @@ impl ComponentSystem<'_> {
         }
         self.solve()?;
         Ok(removed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{ComponentSystem, Weights};
+    use crate::cones::frames::Frames;
+    use crate::cones::test_meshes::{square_annulus, torus};
+    use crate::features::boundary_turning;
+    use crate::mesh::TriMesh;
+
+    /// A trial's response from the curvature system must be the change the
+    /// full KKT gives when the transfer is made and everything is re-solved,
+    /// `phi` and `h~` alike (the annulus has an alignment path, the torus
+    /// two homology loops).
+    fn responses_match_the_kkt(mesh: &TriMesh) {
+        let frames = Frames::new(mesh);
+        let boundary_k = boundary_turning(mesh);
+        let weights = Weights { alpha_smooth: 0.01, miq: false };
+        let mut sys = ComponentSystem::new(mesh, &frames, 0, &boundary_k, weights).unwrap();
+        sys.round_all(&mut |_, _| {}).unwrap();
+        let nv = sys.tree.vertices.len();
+        let interior: Vec<usize> = (0..nv).filter(|&i| !mesh.is_boundary_vertex(sys.tree.vertices[i])).collect();
+        let transfer = (interior[interior.len() / 3], interior[2 * interior.len() / 3], 1);
+        let dx = sys.responses(&[vec![transfer]]).unwrap();
+        let before = sys.x.clone();
+        sys.transfer(transfer);
+        sys.solve().unwrap();
+        let width = sys.response_width();
+        let scale = dx.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        assert!(scale > 1e-6, "the transfer changes phi");
+        for i in 0..width {
+            let exact = sys.x[i] - before[i];
+            assert!((exact - dx[i]).abs() < 1e-7 * scale, "unknown {i}: KKT {exact} vs curvature {}", dx[i]);
+        }
+    }
+
+    #[test]
+    fn curvature_responses_match_the_kkt_on_an_annulus() {
+        responses_match_the_kkt(&square_annulus(6, 4, 0.4, 30f64.to_radians()));
+    }
+
+    #[test]
+    fn curvature_responses_match_the_kkt_on_a_torus() {
+        responses_match_the_kkt(&torus(16, 8, 2.0, 0.7));
     }
 }
