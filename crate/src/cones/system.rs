@@ -35,7 +35,7 @@ const HARMONIC_WEIGHT: f64 = 1e4;
 const P_PROXIMAL: f64 = 1e-8;
 /// Relative objective increase accepted when the clean-up cancels a close pair.
 pub const MERGE_TOLERANCE: f64 = 0.01;
-/// Total rounding allowed per batch (Algorithm 1: below 0.5).
+/// Total rounding allowed per batch and free cluster (Algorithm 1: below 0.5).
 const ROUNDING_BATCH: f64 = 0.5;
 /// Relative residual the solves of intermediate rounding rounds stop at.
 const ROUNDING_TOLERANCE: f64 = 1e-6;
@@ -471,8 +471,9 @@ impl<'a> ComponentSystem<'a> {
         self.solve()
     }
 
-    /// Algorithm 1: solve, fix the batch of free `p` nearest to integers
-    /// (total rounding below 0.5, at least one), repeat until all are fixed.
+    /// Algorithm 1: solve, fix in every free cluster the `p` nearest to
+    /// integers (total rounding below 0.5 per cluster, at least one; see
+    /// [`Self::round_batch`]), repeat until all are fixed.
     /// `progress(round, free_left)` is called after every solve.
     pub fn round_all(&mut self, progress: &mut dyn FnMut(usize, usize)) -> Result<(), ConeError> {
         // Rounding decisions need far less than the final accuracy: solve
@@ -512,19 +513,64 @@ impl<'a> ComponentSystem<'a> {
                 return Ok(());
             }
             free.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut total = 0.0;
-            let mut batch = Vec::new();
-            for (i, &(d, g)) in free.iter().enumerate() {
-                if i > 0 && total + d >= ROUNDING_BATCH {
-                    break;
-                }
-                total += d;
+            let batch = self.round_batch(&free);
+            for &g in &batch {
                 self.fixed[g] = Some(self.x[p0 + g].round() as i64);
-                batch.push(g);
             }
             self.rounds += 1;
             self.activate_and_solve(&batch)?;
         }
+    }
+
+    /// Step 4 of Algorithm 1 applied per free cluster: in each cluster, the
+    /// free `p` nearest to integers whose total rounding stays below 0.5
+    /// (at least one). `free` holds `(distance to the nearest integer, g)`,
+    /// nearest first. The fixed `p` around a cluster fix its total index, so
+    /// clusters are coupled only through the smooth `phi`; rounding them in
+    /// the same round takes the late rounds from one or two `p` each to one
+    /// batch per cluster (spot: 450 rounds -> 24, bff-bunny: 880 -> 74).
+    fn round_batch(&self, free: &[(f64, usize)]) -> Vec<usize> {
+        let cluster = self.free_clusters(free);
+        // Per cluster: (total rounding, p taken, closed).
+        let mut state: std::collections::HashMap<usize, (f64, usize, bool)> = Default::default();
+        let mut batch = Vec::new();
+        for (&(d, g), &c) in free.iter().zip(&cluster) {
+            let s = state.entry(c).or_insert((0.0, 0, false));
+            if s.2 {
+                continue;
+            }
+            if s.1 > 0 && s.0 + d >= ROUNDING_BATCH {
+                s.2 = true;
+                continue;
+            }
+            s.0 += d;
+            s.1 += 1;
+            batch.push(g);
+        }
+        batch
+    }
+
+    /// For each `(d, g)` of `free`, the free cluster it belongs to: vertices
+    /// joined by free `G` edges (a representative vertex).
+    fn free_clusters(&self, free: &[(f64, usize)]) -> Vec<usize> {
+        let nv = self.tree.vertices.len();
+        let mut parent: Vec<usize> = (0..nv).collect();
+        fn find(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        let ends = |g: usize| self.mesh.edge_vertices(self.tree.g_edges[g]).map(|v| self.local[v as usize] as usize);
+        for &(_, g) in free {
+            let [a, b] = ends(g);
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            if ra != rb {
+                parent[ra] = rb;
+            }
+        }
+        free.iter().map(|&(_, g)| find(&mut parent, ends(g)[0])).collect()
     }
 
     /// The cone index of every local vertex: `k_v = 4 j_v + sum sigma p`
