@@ -2,7 +2,8 @@
 // Benchmark harness: prints a table and writes bench-results/bench.json.
 //
 //   npm run bench                     (setup + build + this script)
-//   node scripts/bench.mjs [--no-native] [--no-browser] [--quick] [--only ENV:STAGE,...]
+//   node scripts/bench.mjs [--no-native] [--no-browser] [--quick] [--big] [--only ENV:STAGE,...]
+//   (--big adds spot subdivided three times, 375 k faces, to native:scaling)
 //
 // Each entry of BENCHES is { env, stage, run(ctx) } and returns rows
 // { input, faces?, ms, runs?, note? } (env/stage are filled in). Later pipeline
@@ -174,10 +175,10 @@ function wasmNodeImport(ctx) {
   return rows;
 }
 
-/** The fandisk subdivided `levels` times (cached in the temp dir), e.g. 2 → 207 k faces. */
+/** `source` subdivided `levels` times (cached in the temp dir), e.g. fandisk 2 → 207 k faces. */
 function subObj(source, levels) {
   const dir = path.join(os.tmpdir(), 'conemap-bench');
-  const file = path.join(dir, `fandisk-sub${levels}.obj`);
+  const file = path.join(dir, `${path.basename(source, '.obj')}-sub${levels}.obj`);
   let mesh = readObj(source);
   const faces = (mesh.triangles.length / 3) * 4 ** levels;
   if (fs.existsSync(file) && fs.statSync(file).mtimeMs >= fs.statSync(source).mtimeMs) return { file, faces };
@@ -193,9 +194,8 @@ function subObj(source, levels) {
  * edges (> 60°) as features and without features, α = 0.01; one row per stage.
  */
 function nativeSolve(ctx) {
-  const build = spawnSync('cargo', ['build', '--quiet', '--release', '-p', 'conemap', '--bin', 'conemap'], { cwd: root, env, encoding: 'utf8' });
-  if (build.status !== 0) return { skipped: `cargo build failed: ${(build.stderr || '').trim().split('\n').slice(-2).join(' | ')}` };
-  const bin = path.join(root, 'target/release/conemap');
+  const bin = releaseCli();
+  if (bin.skipped) return bin;
   const file = ctx.inputs[0].file;
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-solve-'));
   const rows = [];
@@ -220,6 +220,79 @@ function nativeSolve(ctx) {
     ]) rows.push({ stage, input, faces: j.output.faces, ms: sec * 1000, note: stage.endsWith('total') ? note : '' });
   }
   fs.rmSync(dir, { recursive: true, force: true });
+  return rows;
+}
+
+/** Builds the release CLI; returns its path, or `{ skipped }`. */
+function releaseCli() {
+  const build = spawnSync('cargo', ['build', '--quiet', '--release', '-p', 'conemap', '--bin', 'conemap'], { cwd: root, env, encoding: 'utf8' });
+  if (build.status !== 0) return { skipped: `cargo build failed: ${(build.stderr || '').trim().split('\n').slice(-2).join(' | ')}` };
+  return path.join(root, 'target/release/conemap');
+}
+
+/** `conemap solve FILE --report` (α = 0.01, no features): the report, or `{ skipped }`. */
+function solveReport(bin, file, extra = []) {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-solve-'));
+  try {
+    const report = path.join(dir, 'report.json');
+    const r = spawnSync(bin, ['solve', file, ...extra, '-o', path.join(dir, 'out.glb'), '--report', report, '--quiet'], { encoding: 'utf8' });
+    if (r.status !== 0) return { skipped: `conemap solve ${path.basename(file)} failed: ${(r.stderr || '').trim()}` };
+    return JSON.parse(fs.readFileSync(report, 'utf8'));
+  } finally {
+    fs.rmSync(dir, { recursive: true, force: true });
+  }
+}
+
+/** One row per solve: faces, cones, distortion, flips, rounds and seconds per stage in the note. */
+function solveRow(stage, input, j) {
+  const t = j.timings;
+  const wound = j.metrics.wound_vertices;
+  const note = `${j.cones.length} cones, distortion ${j.metrics.distortion.toFixed(3)}, ${j.metrics.flipped} flipped, ${wound} wound, `
+    + `${j.rounds} rounds; s: cones ${t.cones_total.toFixed(2)} (rounding ${t.cones.rounding.toFixed(2)}, moves ${t.cones.cone_moves.toFixed(2)}), param ${t.param_total.toFixed(2)}`;
+  return { stage, input, faces: j.faces, ms: t.total * 1000, note };
+}
+
+const sharedMeshes = path.join(root, '..', 'shared', 'meshes');
+/** The clean shared samples of 4 k-35 k faces (file → UV targets of issue 13). */
+const SAMPLES = ['bff-hemisphere', 'spot', 'cow', 'alligator', 'teapot', 'bff-punctured-torus', 'bff-maze', 'fandisk', 'bff-bunny', 'bff-cowhead', 'bff-face'];
+
+/** Every clean shared sample natively, α = 0.01, no features (`../shared/meshes`). */
+function nativeSamples() {
+  if (!fs.existsSync(sharedMeshes)) return { skipped: `${sharedMeshes} not found` };
+  const bin = releaseCli();
+  if (bin.skipped) return bin;
+  const rows = [];
+  for (const name of SAMPLES) {
+    const j = solveReport(bin, path.join(sharedMeshes, `${name}.obj`));
+    if (j.skipped) return j;
+    rows.push(solveRow('file → UVs', `${name}.obj`, j));
+  }
+  return rows;
+}
+
+/**
+ * Growth with mesh size: spot subdivided 0-2 times (0-3 with --big), α = 0.01;
+ * a row per size and the fitted exponent e of time ∝ faces^e.
+ */
+function nativeScaling() {
+  const spot = path.join(sharedMeshes, 'spot.obj');
+  if (!fs.existsSync(spot)) return { skipped: `${spot} not found` };
+  const bin = releaseCli();
+  if (bin.skipped) return bin;
+  const rows = [];
+  const points = [];
+  for (let levels = 0; levels <= (args.has('--big') ? 3 : 2); levels++) {
+    const { file } = levels ? subObj(spot, levels) : { file: spot };
+    const j = solveReport(bin, file);
+    if (j.skipped) return j;
+    rows.push(solveRow('file → UVs', `spot.obj ×4^${levels}`, j));
+    points.push([Math.log(j.faces), Math.log(j.timings.total)]);
+  }
+  const n = points.length;
+  const mx = points.reduce((a, p) => a + p[0], 0) / n;
+  const my = points.reduce((a, p) => a + p[1], 0) / n;
+  const e = points.reduce((a, p) => a + (p[0] - mx) * (p[1] - my), 0) / points.reduce((a, p) => a + (p[0] - mx) ** 2, 0);
+  rows.push({ stage: 'growth exponent', input: 'spot.obj family', ms: NaN, note: `time ∝ faces^${e.toFixed(2)} (least squares over ${n} sizes)` });
   return rows;
 }
 
@@ -490,6 +563,8 @@ const BENCHES = [
   { env: 'wasm-node', stage: 'import', run: wasmNodeImport, enabled: true },
   { env: 'wasm-node', stage: 'cones', run: wasmNodeCones, enabled: true },
   { env: 'native', stage: 'solve', run: nativeSolve, enabled: !args.has('--no-native') },
+  { env: 'native', stage: 'samples', run: nativeSamples, enabled: !args.has('--no-native') },
+  { env: 'native', stage: 'scaling', run: nativeScaling, enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'solve', run: wasmNodeSolve, enabled: true },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },

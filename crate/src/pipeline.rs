@@ -60,6 +60,11 @@ pub enum SolveCause {
     /// Component placements from elsewhere that do not fit the stage.
     Components(MismatchError),
     Param(ParamError),
+    /// The best map after every flip refinement still folds: `flipped`
+    /// triangles with UV area <= 0, `wound` folded vertices
+    /// ([`param::metrics::Metrics::wound_vertices`]); `faces` are the
+    /// flipped triangles and those around the folded vertices.
+    Folded { flipped: usize, wound: usize, refinements: usize, faces: Vec<u32> },
 }
 
 impl fmt::Display for SolveCause {
@@ -68,6 +73,10 @@ impl fmt::Display for SolveCause {
             SolveCause::Cones(e) => write!(f, "{e}"),
             SolveCause::Components(e) => write!(f, "{e}"),
             SolveCause::Param(e) => write!(f, "parametrization: {e}"),
+            SolveCause::Folded { flipped, wound, refinements, .. } => write!(
+                f,
+                "parametrization: the map still folds after {refinements} refinements ({flipped} flipped triangles, {wound} folded vertices)"
+            ),
         }
     }
 }
@@ -171,6 +180,29 @@ impl Solution<'_> {
         (0..self.mesh.n_faces() as u32)
             .filter(|&f| !(param::seamless::signed_uv_area([0, 1, 2].map(|k| uv[3 * f as usize + k])) > 0.0))
             .collect()
+    }
+
+    /// Flipped faces and the faces around folded vertices (of `mesh`).
+    fn folded_faces(&self) -> Vec<u32> {
+        let wound = param::metrics::wound_vertices(&self.mesh, &self.placement, &self.param.uv);
+        let mut faces = self.flipped_faces();
+        faces.extend(wound.iter().flat_map(|&v| self.mesh.vertex_faces(v)));
+        faces.sort_unstable();
+        faces.dedup();
+        faces
+    }
+
+    /// How the mesh solved on maps to the input `mesh` (with its `features`).
+    fn lift<'s>(&'s self, input: &'s TriMesh, features: &'s FeatureSet) -> Lift<'s> {
+        Lift {
+            input,
+            features,
+            solved: &self.mesh,
+            solved_features: &self.features,
+            original_vertex: self.original_vertex.as_deref(),
+            original_edge: self.original_edge.as_deref(),
+            original_face: self.original_face.as_deref(),
+        }
     }
 
     /// Faces (of `mesh`) around the cones the map realized with another
@@ -476,6 +508,17 @@ impl Placed {
                 }
                 _ => break,
             }
+        }
+        // A map that folds is not a result (issue 13): name where it folds.
+        let m = &best.param.metrics;
+        if m.flipped > 0 || m.wound_vertices > 0 {
+            let cause = SolveCause::Folded {
+                flipped: m.flipped,
+                wound: m.wound_vertices,
+                refinements: best.flip_refinements,
+                faces: best.folded_faces(),
+            };
+            return Err(SolveError::new(&best.lift(mesh, features), cause));
         }
         Ok(best)
     }

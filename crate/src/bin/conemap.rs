@@ -40,7 +40,7 @@ commands:
                        characteristic, genus) and every problem found.
                        --json prints one JSON object instead.
 
-  cones FILE [--alpha A] [--miq] [--sharp DEG] [--min-feature-length N|X%]
+  cones FILE [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
              [--no-moves] [--json]
                        place cones (Myles & Zorin 2013, sections 4-5).
@@ -57,8 +57,12 @@ commands:
                        {\"edges\": [[[x,y,z],[x,y,z]], ...]} of feature edges
                        by end positions. --no-moves: skip the cone-location
                        optimization. --json prints one JSON object.
+                       On a terminal, the stage and its progress (rounding
+                       round and integers left, cone-move pass, ARAP and
+                       injective iterations) show on standard error while
+                       it runs; --quiet turns that off.
 
-  solve FILE -o OUT [--alpha A] [--miq] [--sharp DEG] [--min-feature-length N|X%]
+  solve FILE -o OUT [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
              [--no-moves] [--report REPORT.json] [--checker]
                        place cones, compute the seamless parametrization and
@@ -82,10 +86,11 @@ problems), 1 when the input could not be read, parsed or used, 2 for bad usage."
 /// Commands and the flags they accept.
 const COMMANDS: &[(&str, &[&str])] = &[
     ("info", &["--json"]),
-    ("cones", &["--json", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features="]),
+    ("cones", &["--json", "--quiet", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features="]),
     (
         "solve",
         &[
+            "--quiet",
             "--miq",
             "--no-moves",
             "--checker",
@@ -337,14 +342,72 @@ fn cone_options(args: &Args) -> Result<ConeOptions, Failure> {
     Ok(ConeOptions { alpha_smooth: alpha, miq, optimize_locations: !args.flag("--no-moves"), ..ConeOptions::default() })
 }
 
+/// The stage and its progress on one line of standard error, while a long
+/// command runs: only when standard error is a terminal and `--quiet` is
+/// not given (nothing is printed otherwise).
+struct ProgressLine(Option<indicatif::ProgressBar>);
+
+impl ProgressLine {
+    fn new(args: &Args) -> ProgressLine {
+        use std::io::IsTerminal as _;
+        if args.flag("--quiet") || !std::io::stderr().is_terminal() {
+            return ProgressLine(None);
+        }
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.set_style(indicatif::ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}").expect("valid template"));
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        ProgressLine(Some(bar))
+    }
+
+    fn say(&self, message: impl FnOnce() -> String) {
+        if let Some(bar) = &self.0 {
+            bar.set_message(message());
+        }
+    }
+
+    fn cones(&self, p: &cones::Progress) {
+        use cones::Progress::*;
+        self.say(|| match *p {
+            Topology { component, components } => format!("cones: component {} of {components}, path basis", component + 1),
+            Rounding { component, round, free } => {
+                format!("cones: component {}, rounding round {round}, {free} integers free", component + 1)
+            }
+            ConeMoves { component, pass } => format!("cones: component {}, cone moves, pass {}", component + 1, pass + 1),
+            PairCancellation { component, removed } => {
+                format!("cones: component {}, pair cancellation, {removed} removed", component + 1)
+            }
+        });
+    }
+
+    fn param(&self, p: &conemap::param::ParamProgress) {
+        use conemap::param::ParamProgress::*;
+        self.say(|| match *p {
+            Field => "parametrization: cross field".to_string(),
+            Cut => "parametrization: cut graph".to_string(),
+            Poisson => "parametrization: Poisson solve".to_string(),
+            Arap { iteration, max } => format!("parametrization: ARAP iteration {iteration} of at most {max}"),
+            Repair { round, flips } => format!("parametrization: fold-over repair round {round}, {flips} flipped"),
+            Injective { iteration, max } => format!("parametrization: injective iteration {iteration} of at most {max}"),
+        });
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.0 {
+            bar.finish_and_clear();
+        }
+    }
+}
+
 fn cones_command(args: &Args) -> Result<(), Failure> {
     let file = args.file()?;
     let mesh = load_mesh(file)?;
     let features = load_features(args, &mesh)?;
     let options = cone_options(args)?;
     let solve_options = conemap::pipeline::SolveOptions { cones: options, ..Default::default() };
-    let placed = conemap::pipeline::place_cones(&mesh, &features, &solve_options, &mut |_| {})
-        .map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let bar = ProgressLine::new(args);
+    let placed = conemap::pipeline::place_cones(&mesh, &features, &solve_options, &mut |p| bar.cones(&p));
+    bar.finish();
+    let placed = placed.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let (solved, result) = (placed.mesh(&mesh), &placed.placement);
     let (splits, counts) = placed.refinement();
     if args.flag("--json") {
@@ -450,7 +513,13 @@ fn solve(args: &Args) -> Result<(), Failure> {
 
     let features = load_features(args, &mesh)?;
     let solve_options = SolveOptions { cones: options, ..SolveOptions::default() };
-    let solution = pipeline::solve(&mesh, &features, &solve_options, &mut |_| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let bar = ProgressLine::new(args);
+    let solution = pipeline::solve(&mesh, &features, &solve_options, &mut |p| match p {
+        pipeline::SolveProgress::Cones(p) => bar.cones(&p),
+        pipeline::SolveProgress::Param(p) => bar.param(&p),
+    });
+    bar.finish();
+    let solution = solution.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let (placement, result) = (&solution.placement, &solution.param);
     let alignment = solution.feature_alignment(&mesh, &features);
     let t_cones = solution.refine_seconds + placement.timings.total;

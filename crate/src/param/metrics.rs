@@ -23,8 +23,10 @@ pub struct Metrics {
     pub max_distortion: f64,
     /// Triangles with signed UV area ≤ 0.
     pub flipped: usize,
-    /// Interior vertices around which the map winds more than once (UV angle
-    /// sum off the cone angle by more than pi) although no triangle flips.
+    /// Interior vertices where the map folds: the *signed* UV angle sum is
+    /// off the cone angle by more than pi (the map winds around them more or
+    /// less than the cone needs, including vertices ringed by flipped
+    /// triangles, whose sum is 0 or -2 pi).
     pub wound_vertices: usize,
     /// Largest deviation (radians) of a seam edge's transition from a multiple of 90°.
     pub seam_angle_residual: f64,
@@ -91,6 +93,25 @@ pub fn uv_angle_sums(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<f64> {
         }
     }
     sums
+}
+
+/// Interior vertices where the map folds ([`Metrics::wound_vertices`]):
+/// signed UV angle sum off the vertex's cone angle by more than pi.
+pub fn wound_vertices(mesh: &TriMesh, placement: &ConePlacement, uv: &[[f64; 2]]) -> Vec<u32> {
+    let mut sums = vec![0.0; mesh.n_vertices()];
+    for (f, t) in mesh.faces().iter().enumerate() {
+        let sign = if signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]) < 0.0 { -1.0 } else { 1.0 };
+        for k in 0..3 {
+            sums[t[k] as usize] += sign * corner_angle(uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
+        }
+    }
+    let cone_angle = super::seamless::interior_cone_angles(mesh, placement);
+    (0..mesh.n_vertices() as u32)
+        .filter(|&v| {
+            let expected = cone_angle[v as usize];
+            expected.is_finite() && (sums[v as usize] - expected).abs() > std::f64::consts::PI
+        })
+        .collect()
 }
 
 /// Unsigned UV angle at corner `p` of the triangle `(p, a, b)`.
@@ -193,12 +214,7 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
             alignment = alignment.max(axis_deviation(ang));
         }
     }
-    let cone_angle = super::seamless::interior_cone_angles(mesh, placement);
-    let wound_vertices = uv_angle_sums(mesh, uv)
-        .iter()
-        .zip(&cone_angle)
-        .filter(|(sum, expected)| expected.is_finite() && (*sum - *expected).abs() > std::f64::consts::PI)
-        .count();
+    let wound_vertices = wound_vertices(mesh, placement, uv).len();
     Metrics {
         distortion,
         scale,

@@ -271,6 +271,21 @@ pub(super) fn locate(lift: &Lift, cause: &SolveCause) -> Option<(ErrorLocation, 
             let message = format!("cone placement: boundary turning at {} is inconsistent", site.describe(input));
             Some((ErrorLocation { vertices: site.vertices(input), edges }, message))
         }
+        SolveCause::Folded { flipped, wound, faces, .. } => {
+            let input_faces: Vec<u32> = match lift.original_face {
+                Some(of) => faces.iter().map(|&f| of[f as usize]).collect(),
+                None => faces.clone(),
+            };
+            let mut edges: Vec<u32> = input_faces.iter().flat_map(|&f| (0..3).map(move |k| input.edge(3 * f + k))).collect();
+            edges.sort_unstable();
+            edges.dedup();
+            edges.truncate(MAX_LOCATION_EDGES);
+            let message = format!(
+                "parametrization: the map still folds ({flipped} flipped triangles, {wound} folded vertices; their edges are highlighted): \
+                 unmark or mark features near them, change alpha, or subdivide the mesh there"
+            );
+            Some((ErrorLocation { vertices: Vec::new(), edges }, message))
+        }
         _ => None,
     }
 }
