@@ -7,7 +7,7 @@
 //! ([`SolveError::location`], module `location`).
 
 use crate::clock::{now_seconds, Stopwatch};
-use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError};
+use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError, RoundingRule};
 use crate::features::{refine_for_features, split_around, split_flipped, FeatureSet, RefineCounts, Refined};
 use crate::mesh::TriMesh;
 use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrization};
@@ -485,6 +485,7 @@ impl Placed {
         progress: &mut dyn FnMut(SolveProgress),
     ) -> Result<Solution<'a>, SolveError> {
         let options = self.options;
+        let (initial, refine_seconds) = (self.refined.clone(), self.refine_seconds);
         let mut best = self.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p)))?;
         for _ in 0..options.refine.max_flip_refinements {
             let mut flipped = best.flipped_faces();
@@ -509,7 +510,21 @@ impl Placed {
                 _ => break,
             }
         }
-        // A map that folds is not a result (issue 13): name where it folds.
+        // A map that folds is not a result (issue 13). Per-cluster rounding
+        // decides in parallel what the paper's rule decides one batch at a
+        // time; where that placement folds, place once more the paper's way.
+        let m = &best.param.metrics;
+        if (m.flipped > 0 || m.wound_vertices > 0) && options.cones.rounding == RoundingRule::PerCluster {
+            let mut whole = options;
+            whole.cones.rounding = RoundingRule::Whole;
+            let stage = ConeStage::with_refinement(mesh, features, &whole, initial, 0, refine_seconds, now_seconds());
+            let attempt = stage
+                .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
+                .and_then(|placed| placed.parametrize(mesh, features, progress));
+            if let Ok(solution) = attempt {
+                return Ok(solution);
+            }
+        }
         let m = &best.param.metrics;
         if m.flipped > 0 || m.wound_vertices > 0 {
             let cause = SolveCause::Folded {

@@ -30,6 +30,10 @@ pub const MIQ_ALPHA: f64 = 100.0;
 /// Accepted range of `alpha_smooth`.
 pub const ALPHA_RANGE: (f64, f64) = (1e-4, 1e3);
 
+/// Default of [`ConeOptions::coarse_vertices`]: about the size of the
+/// samples whose placement is good and fast (spot has 2 930 vertices).
+pub const COARSE_VERTICES: usize = 4000;
+
 /// Settings of the cone placement.
 #[derive(Clone, Copy, Debug)]
 pub struct ConeOptions {
@@ -46,6 +50,25 @@ pub struct ConeOptions {
     /// Cancel distant opposite pairs while the objective decreases (0 = off):
     /// each cone is tried against this many nearest opposite cones.
     pub cancel_pairs_nearest: usize,
+    /// Components with more interior vertices than this are placed coarse
+    /// to fine (`usize::MAX`: never): the cones are placed on a decimation
+    /// to this many interior vertices, then moved on the component itself.
+    pub coarse_vertices: usize,
+    /// How Algorithm 1 batches its fixes.
+    pub rounding: RoundingRule,
+}
+
+/// How each round of Algorithm 1 picks the `p` to fix (see
+/// docs/cone-placement.md, "Algorithm 1 and cone moves").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RoundingRule {
+    /// The paper's batch (total rounding below 0.5) in every free cluster
+    /// at once: a few dozen rounds.
+    PerCluster,
+    /// The paper's batch over the whole component: hundreds of rounds; the
+    /// pipeline falls back to it when a per-cluster placement gives a map
+    /// that folds.
+    Whole,
 }
 
 impl Default for ConeOptions {
@@ -57,6 +80,8 @@ impl Default for ConeOptions {
             max_move_passes: 20,
             merge_close_pairs: true,
             cancel_pairs_nearest: 3,
+            coarse_vertices: COARSE_VERTICES,
+            rounding: RoundingRule::PerCluster,
         }
     }
 }

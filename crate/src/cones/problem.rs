@@ -10,7 +10,7 @@ use super::system::{ComponentSystem, Weights};
 use super::{original_cones, ComponentCones, ConeError, ConeOptions, ConePlacement, ConeTimings, Progress};
 use crate::clock::Stopwatch;
 use crate::features::{boundary_turning, cut_open, CutMesh, FeatureSet};
-use crate::mesh::TriMesh;
+use crate::mesh::{decimate_interior, TriMesh};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -50,6 +50,31 @@ pub struct ComponentPlacement {
     pub topology_seconds: f64,
     pub rounding_seconds: f64,
     pub moves_seconds: f64,
+}
+
+/// The steps after the integers are fixed: cone moves and the clean-ups
+/// (pair merging, pair cancellation, spreading of cones above index 3).
+/// Returns (moves, merged pairs, cancelled pairs, quarter turns spread).
+fn improve(
+    sys: &mut ComponentSystem,
+    options: &ConeOptions,
+    c: usize,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(usize, usize, usize, usize), ConeError> {
+    let moves = if options.optimize_locations {
+        sys.optimize_locations(options.max_move_passes, &mut |pass| progress(Progress::ConeMoves { component: c, pass }))?
+    } else {
+        0
+    };
+    let merged = if options.merge_close_pairs { sys.merge_close_pairs()? } else { 0 };
+    let cancelled = if options.cancel_pairs_nearest > 0 {
+        sys.cancel_pairs(options.cancel_pairs_nearest, &mut |n| progress(Progress::PairCancellation { component: c, removed: n }))?
+    } else {
+        0
+    };
+    // Last, so that no later step gathers the quarter turns again.
+    let spread = sys.spread_degenerate_cones()?;
+    Ok((moves, merged, cancelled, spread))
 }
 
 /// Component placements that do not fit the problem: a component missing or
@@ -125,22 +150,24 @@ impl ConeProblem {
         let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
         progress(Progress::Topology { component: c, components: self.n_components() });
         let mut sys = ComponentSystem::new(cm, frames, self.seeds[c], &self.boundary_k, weights)?;
+        sys.rounding = options.rounding;
         let topology_seconds = clock.lap();
-        sys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free }))?;
+        let mut rounds = None;
+        if let Some((k, coarse_rounds)) = self.coarse_indices(c, &sys, progress) {
+            if sys.fix_indices(&k).is_ok() {
+                rounds = Some(coarse_rounds);
+            }
+        }
+        if rounds.is_none() {
+            sys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free }))?;
+        }
         let rounding_seconds = clock.lap();
-        let moves = if options.optimize_locations {
-            sys.optimize_locations(options.max_move_passes, &mut |pass| progress(Progress::ConeMoves { component: c, pass }))?
-        } else {
-            0
-        };
-        let merged = if options.merge_close_pairs { sys.merge_close_pairs()? } else { 0 };
-        let cancelled = if options.cancel_pairs_nearest > 0 {
-            sys.cancel_pairs(options.cancel_pairs_nearest, &mut |n| progress(Progress::PairCancellation { component: c, removed: n }))?
-        } else {
-            0
-        };
-        // Last, so that no later step gathers the quarter turns again.
-        let spread = sys.spread_degenerate_cones()?;
+        // Placed coarse, the cones only move here: the clean-ups ran on the
+        // coarse mesh, and their objective is not resolution-independent (the
+        // Dirichlet energy of phi near a cone grows like log(1/h)), so on the
+        // fine mesh they would cancel pairs the coarse solve kept.
+        let fine_options = if rounds.is_some() { ConeOptions { merge_close_pairs: false, cancel_pairs_nearest: 0, ..*options } } else { *options };
+        let (moves, merged, cancelled, spread) = improve(&mut sys, &fine_options, c, progress)?;
 
         let kv = sys.vertex_k();
         let phi = sys.phi().to_vec();
@@ -170,7 +197,7 @@ impl ConeProblem {
             k_sum: kv.iter().sum(),
             path_integers: sys.tree.leftovers.iter().map(|&e| sys.fixed[sys.tree.g_index[e as usize] as usize].unwrap_or(0)).collect(),
             h,
-            rounds: sys.rounds,
+            rounds: rounds.unwrap_or(sys.rounds),
             moves,
             merged_pairs: merged,
             cancelled_pairs: cancelled,
@@ -193,6 +220,59 @@ impl ConeProblem {
             rounding_seconds,
             moves_seconds: clock.lap(),
         })
+    }
+
+    /// Cone indices per local vertex of `sys` (component `c`) placed on a
+    /// decimation of the component ([`decimate_interior`]: boundary and
+    /// feature curves kept, so the boundary integers are the same), and the
+    /// rounds that took; `None` when the component is small enough to place
+    /// directly or the coarse placement fails (the caller then rounds here).
+    fn coarse_indices(&self, c: usize, sys: &ComponentSystem, progress: &mut dyn FnMut(Progress)) -> Option<(Vec<i64>, usize)> {
+        let (cm, options) = (&self.cut.mesh, &self.options);
+        let vertices = &sys.tree.vertices;
+        let interior = vertices.iter().filter(|&&v| !cm.is_boundary_vertex(v)).count();
+        if interior <= options.coarse_vertices {
+            return None;
+        }
+        // The component alone, numbered in order of first use.
+        let mut sub_id = vec![u32::MAX; cm.n_vertices()];
+        let mut sub_vertex = Vec::new();
+        let triangles: Vec<[u32; 3]> = sys
+            .tree
+            .faces
+            .iter()
+            .map(|&f| {
+                cm.faces()[f as usize].map(|v| {
+                    if sub_id[v as usize] == u32::MAX {
+                        sub_id[v as usize] = sub_vertex.len() as u32;
+                        sub_vertex.push(v);
+                    }
+                    sub_id[v as usize]
+                })
+            })
+            .collect();
+        let positions = sub_vertex.iter().map(|&v| cm.position(v)).collect();
+        let sub = TriMesh::from_welded_arrays(positions, triangles).ok()?;
+        if sub.n_vertices() != sub_vertex.len() {
+            return None;
+        }
+        let coarse = decimate_interior(&sub, options.coarse_vertices)?;
+        let to_cut = |cv: u32| sub_vertex[coarse.vertex[cv as usize] as usize];
+        let boundary_k: Vec<i32> = (0..coarse.mesh.n_vertices() as u32).map(|cv| self.boundary_k[to_cut(cv) as usize]).collect();
+        let frames = Frames::new(&coarse.mesh);
+        let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
+        let mut csys = ComponentSystem::new(&coarse.mesh, &frames, 0, &boundary_k, weights).ok()?;
+        csys.rounding = options.rounding;
+        csys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free })).ok()?;
+        improve(&mut csys, options, c, &mut |_| {}).ok()?;
+        let mut k: Vec<i64> = vertices.iter().map(|&v| if cm.is_boundary_vertex(v) { self.boundary_k[v as usize] as i64 } else { 0 }).collect();
+        for (i, ki) in csys.vertex_k().into_iter().enumerate() {
+            let v = to_cut(csys.tree.vertices[i]);
+            if !cm.is_boundary_vertex(v) {
+                k[sys.local(v) as usize] = ki;
+            }
+        }
+        Some((k, csys.rounds))
     }
 
     /// Joins one placement per component (any order) into the placement of

@@ -18,6 +18,7 @@
 use super::dual_tree::DualTree;
 use super::frames::{vertex_cycle, Frames, Visit};
 use super::harmonic::HarmonicBasis;
+use super::RoundingRule;
 use crate::linalg::{FixBorder, Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
 use crate::mesh::{TriMesh, NONE};
 use crate::vec3;
@@ -25,6 +26,7 @@ use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::PI;
 
 mod curvature;
+mod indices;
 mod moves;
 
 use curvature::CurvatureSystem;
@@ -114,6 +116,8 @@ pub struct ComponentSystem<'a> {
     /// The curvature equation alone, for trials once every `p` is fixed
     /// (built on first use).
     curvature: Option<CurvatureSystem>,
+    /// How [`Self::round_all`] batches its fixes.
+    pub rounding: RoundingRule,
 }
 
 /// What went wrong while placing cones.
@@ -363,6 +367,7 @@ impl<'a> ComponentSystem<'a> {
             laplacian,
             path_rows,
             curvature: None,
+            rounding: RoundingRule::PerCluster,
         })
     }
 
@@ -530,7 +535,10 @@ impl<'a> ComponentSystem<'a> {
     /// the same round takes the late rounds from one or two `p` each to one
     /// batch per cluster (spot: 450 rounds -> 24, bff-bunny: 880 -> 74).
     fn round_batch(&self, free: &[(f64, usize)]) -> Vec<usize> {
-        let cluster = self.free_clusters(free);
+        let cluster = match self.rounding {
+            RoundingRule::PerCluster => self.free_clusters(free),
+            RoundingRule::Whole => vec![0; free.len()],
+        };
         // Per cluster: (total rounding, p taken, closed).
         let mut state: std::collections::HashMap<usize, (f64, usize, bool)> = Default::default();
         let mut batch = Vec::new();

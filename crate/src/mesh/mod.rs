@@ -5,6 +5,7 @@
 //! [`analyze()`] (figures and [`crate::Problem`]s, never fails) →
 //! [`TriMesh::from_raw`] (fails with the blocking problems).
 
+mod decimate;
 mod raw;
 pub mod shapes;
 mod subdivide;
@@ -16,6 +17,7 @@ mod weld;
 #[cfg(test)]
 mod tests;
 
+pub use decimate::{decimate_interior, Decimated};
 pub use raw::RawMesh;
 pub use subdivide::subdivide_midpoint;
 pub use trimesh::{Outgoing, TriMesh, NONE};

@@ -107,6 +107,18 @@ impl CurvatureSystem {
         Ok(())
     }
 
+    /// `h~ = B_h⁻¹ (shift - B_phi phi)`: the path rows solved for the
+    /// harmonic part (`shift`: their right-hand side plus `(pi/2) p_l`).
+    pub fn harmonic(&self, phi: &[f64], shift: &[f64]) -> Result<Vec<f64>, SolveError> {
+        let Some(lu) = &self.path_h else { return Ok(Vec::new()) };
+        let rhs = DVector::from_iterator(
+            self.path_phi.len(),
+            self.path_phi.iter().zip(shift).map(|(row, s)| s - row.iter().map(|&(v, w)| w * phi[v]).sum::<f64>()),
+        );
+        let h = lu.solve(&rhs).ok_or(SolveError::NotFinite { what: "path rows' harmonic block" })?;
+        Ok(h.as_slice().to_vec())
+    }
+
     /// First-order sensitivity of `phiᵀ M phi / A` at `phi` (of zero
     /// `M`-mean) to moving cone index: `Phi` with a transfer of `a` quarter
     /// turns from `u` to `w` changing it by about `2 a (Phi[w] - Phi[u])`.

@@ -59,7 +59,7 @@ impl ComponentSystem<'_> {
     }
 
     /// The curvature system of the final integers (factorized on first use).
-    fn curvature(&mut self) -> Result<&CurvatureSystem, ConeError> {
+    pub(super) fn curvature(&mut self) -> Result<&CurvatureSystem, ConeError> {
         if self.curvature.is_none() {
             let mass: Vec<f64> = self.area.iter().map(|a| a / self.total_area).collect();
             let nh = self.basis.len();
