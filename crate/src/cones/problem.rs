@@ -52,6 +52,10 @@ pub struct ComponentPlacement {
     pub moves_seconds: f64,
 }
 
+/// Each level of the coarse-to-fine placement has at most this fraction of
+/// the interior vertices of the next finer one.
+const COARSENING: usize = 4;
+
 /// The steps after the integers are fixed: cone moves and the clean-ups
 /// (pair merging, pair cancellation, spreading of cones above index 3).
 /// Returns (moves, merged pairs, cancelled pairs, quarter turns spread).
@@ -256,23 +260,56 @@ impl ConeProblem {
         if sub.n_vertices() != sub_vertex.len() {
             return None;
         }
-        let coarse = decimate_interior(&sub, options.coarse_vertices)?;
-        let to_cut = |cv: u32| sub_vertex[coarse.vertex[cv as usize] as usize];
-        let boundary_k: Vec<i32> = (0..coarse.mesh.n_vertices() as u32).map(|cv| self.boundary_k[to_cut(cv) as usize]).collect();
-        let frames = Frames::new(&coarse.mesh);
-        let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
-        let mut csys = ComponentSystem::new(&coarse.mesh, &frames, 0, &boundary_k, weights).ok()?;
-        csys.rounding = options.rounding;
-        csys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free })).ok()?;
-        improve(&mut csys, options, c, &mut |_| {}).ok()?;
-        let mut k: Vec<i64> = vertices.iter().map(|&v| if cm.is_boundary_vertex(v) { self.boundary_k[v as usize] as i64 } else { 0 }).collect();
-        for (i, ki) in csys.vertex_k().into_iter().enumerate() {
-            let v = to_cut(csys.tree.vertices[i]);
-            if !cm.is_boundary_vertex(v) {
-                k[sys.local(v) as usize] = ki;
+        // Levels, each a decimation of the previous to a quarter of its
+        // interior (at least the coarse size): the cones settle at every scale.
+        let mut levels: Vec<(TriMesh, Vec<u32>)> = Vec::new(); // (mesh, its vertices in `sub`)
+        loop {
+            let finer = levels.last().map_or(&sub, |l| &l.0);
+            let interior = (0..finer.n_vertices() as u32).filter(|&v| !finer.is_boundary_vertex(v)).count();
+            if interior <= options.coarse_vertices {
+                break;
             }
+            let d = decimate_interior(finer, options.coarse_vertices.max(interior / COARSENING))?;
+            let to_sub: Vec<u32> = match levels.last() {
+                Some((_, up)) => d.vertex.iter().map(|&v| up[v as usize]).collect(),
+                None => d.vertex,
+            };
+            levels.push((d.mesh, to_sub));
         }
-        Some((k, csys.rounds))
+        let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
+        // Per level, coarsest first: indices per `sub` vertex carried down.
+        let mut k_sub: Option<Vec<i64>> = None;
+        let mut rounds = 0;
+        for (mesh, to_sub) in levels.iter().rev() {
+            let to_cut = |v: u32| sub_vertex[to_sub[v as usize] as usize];
+            let boundary_k: Vec<i32> = (0..mesh.n_vertices() as u32).map(|v| self.boundary_k[to_cut(v) as usize]).collect();
+            let frames = Frames::new(mesh);
+            let mut lsys = ComponentSystem::new(mesh, &frames, 0, &boundary_k, weights).ok()?;
+            lsys.rounding = options.rounding;
+            match &k_sub {
+                None => {
+                    lsys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free })).ok()?;
+                    rounds = lsys.rounds;
+                    improve(&mut lsys, options, c, &mut |_| {}).ok()?;
+                }
+                Some(k) => {
+                    let given: Vec<i64> = lsys.tree.vertices.iter().map(|&v| k[to_sub[v as usize] as usize]).collect();
+                    lsys.fix_indices(&given).ok()?;
+                    lsys.optimize_locations(options.max_move_passes, &mut |_| {}).ok()?;
+                }
+            }
+            let mut next: Vec<i64> = sub_vertex.iter().map(|&v| if cm.is_boundary_vertex(v) { self.boundary_k[v as usize] as i64 } else { 0 }).collect();
+            for (i, ki) in lsys.vertex_k().into_iter().enumerate() {
+                let v = to_sub[lsys.tree.vertices[i] as usize];
+                if !sub.is_boundary_vertex(v) {
+                    next[v as usize] = ki;
+                }
+            }
+            k_sub = Some(next);
+        }
+        let k_sub = k_sub?;
+        let k = vertices.iter().map(|&v| k_sub[sub_id[v as usize] as usize]).collect();
+        Some((k, rounds))
     }
 
     /// Joins one placement per component (any order) into the placement of
