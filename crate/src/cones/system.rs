@@ -658,6 +658,15 @@ impl<'a> ComponentSystem<'a> {
     }
 }
 
+/// The system of the component of face 0 of `mesh` at alpha 0.01, with
+/// the mesh's own boundary turning (for tests).
+#[cfg(test)]
+pub(crate) fn test_system(mesh: &TriMesh) -> ComponentSystem<'_> {
+    let frames = Frames::new(mesh);
+    let boundary_k = crate::features::boundary_turning(mesh);
+    ComponentSystem::new(mesh, &frames, 0, &boundary_k, Weights { alpha_smooth: 0.01, miq: false }).unwrap()
+}
+
 /// The `G` edges a cycle crosses, with the sign `+1` when the cycle crosses
 /// in the orientation of the edge's fundamental cycle.
 fn cycle_signs(mesh: &TriMesh, tree: &DualTree, cycle: &[Visit]) -> Vec<(u32, i32)> {

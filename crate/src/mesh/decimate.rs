@@ -119,12 +119,6 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
             }
         }
     }
-    let neighbours = |incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32| -> Vec<u32> {
-        let mut out: Vec<u32> = incident[v as usize].iter().flat_map(|&f| faces[f as usize]).filter(|&w| w != v).collect();
-        out.sort_unstable();
-        out.dedup();
-        out
-    };
     let cost = |quadric: &[Quadric], u: u32, v: u32| {
         let mut q = quadric[u as usize];
         q.add(&quadric[v as usize]);
@@ -148,7 +142,7 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
         if !alive[u as usize] || !alive[v as usize] || c.stamp != (stamp[u as usize], stamp[v as usize]) {
             continue;
         }
-        if !collapse_is_valid(pos, &faces, &incident, u, v, &neighbours) {
+        if !collapse_is_valid(pos, &faces, &incident, u, v) {
             continue;
         }
         // Collapse: drop the faces on edge uv, move u's other faces to v.
@@ -213,6 +207,14 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
     (coarse.n_vertices() == vertex.len()).then_some(Decimated { mesh: coarse, vertex })
 }
 
+/// The vertices sharing a face with `v`, sorted.
+fn neighbours(incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32) -> Vec<u32> {
+    let mut out: Vec<u32> = incident[v as usize].iter().flat_map(|&f| faces[f as usize]).filter(|&w| w != v).collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
 /// The link condition (the common neighbours of `u` and `v` are the two
 /// vertices opposite edge uv) and the shape of the faces `u` moves to `v`.
 fn collapse_is_valid(
@@ -221,7 +223,6 @@ fn collapse_is_valid(
     incident: &[Vec<u32>],
     u: u32,
     v: u32,
-    neighbours: &dyn Fn(&[Vec<u32>], &[[u32; 3]], u32) -> Vec<u32>,
 ) -> bool {
     let (nu, nvv) = (neighbours(incident, faces, u), neighbours(incident, faces, v));
     if !nvv.contains(&u) {

@@ -122,10 +122,8 @@ impl ComponentSystem<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ComponentSystem, Weights};
-    use crate::cones::frames::Frames;
+    use super::super::test_system;
     use crate::cones::test_meshes::{square_annulus, torus};
-    use crate::features::boundary_turning;
     use crate::mesh::TriMesh;
 
     /// Indices rounded by one system, given to a fresh one: every `p` is
@@ -133,14 +131,11 @@ mod tests {
     /// integers reach the same harmonic norm as Algorithm 1's (they
     /// minimize it for the given indices).
     fn indices_round_trip(mesh: &TriMesh) {
-        let frames = Frames::new(mesh);
-        let boundary_k = boundary_turning(mesh);
-        let weights = Weights { alpha_smooth: 0.01, miq: false };
-        let mut rounded = ComponentSystem::new(mesh, &frames, 0, &boundary_k, weights).unwrap();
+        let mut rounded = test_system(mesh);
         rounded.round_all(&mut |_, _| {}).unwrap();
         let k = rounded.vertex_k();
         assert!(k.iter().any(|&ki| ki != 0));
-        let mut given = ComponentSystem::new(mesh, &frames, 0, &boundary_k, weights).unwrap();
+        let mut given = test_system(mesh);
         given.fix_indices(&k).unwrap();
         assert!(given.fixed.iter().all(Option::is_some), "every p fixed");
         assert_eq!(given.vertex_k(), k);
@@ -161,8 +156,7 @@ mod tests {
     #[test]
     fn indices_off_by_a_quarter_turn_are_refused() {
         let mesh = torus(12, 6, 2.0, 0.7);
-        let frames = Frames::new(&mesh);
-        let mut sys = ComponentSystem::new(&mesh, &frames, 0, &boundary_turning(&mesh), Weights { alpha_smooth: 0.01, miq: false }).unwrap();
+        let mut sys = test_system(&mesh);
         let mut k = vec![0; mesh.n_vertices()];
         k[3] = 1; // sum 1, not 4 chi = 0
         assert!(sys.fix_indices(&k).is_err());

@@ -387,10 +387,8 @@ impl ComponentSystem<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ComponentSystem, Weights};
-    use crate::cones::frames::Frames;
+    use super::super::test_system;
     use crate::cones::test_meshes::{square_annulus, torus};
-    use crate::features::boundary_turning;
     use crate::mesh::TriMesh;
 
     /// A trial's response from the curvature system must be the change the
@@ -398,10 +396,7 @@ mod tests {
     /// `phi` and `h~` alike (the annulus has an alignment path, the torus
     /// two homology loops).
     fn responses_match_the_kkt(mesh: &TriMesh) {
-        let frames = Frames::new(mesh);
-        let boundary_k = boundary_turning(mesh);
-        let weights = Weights { alpha_smooth: 0.01, miq: false };
-        let mut sys = ComponentSystem::new(mesh, &frames, 0, &boundary_k, weights).unwrap();
+        let mut sys = test_system(mesh);
         sys.round_all(&mut |_, _| {}).unwrap();
         let nv = sys.tree.vertices.len();
         let interior: Vec<usize> = (0..nv).filter(|&i| !mesh.is_boundary_vertex(sys.tree.vertices[i])).collect();
