@@ -295,7 +295,9 @@ impl ConeProblem {
                 Some(k) => {
                     let given: Vec<i64> = lsys.tree.vertices.iter().map(|&v| k[to_sub[v as usize] as usize]).collect();
                     lsys.fix_indices(&given).ok()?;
-                    lsys.optimize_locations(options.max_move_passes, &mut |_| {}).ok()?;
+                    if options.optimize_locations {
+                        lsys.optimize_locations(options.max_move_passes, &mut |_| {}).ok()?;
+                    }
                 }
             }
             let mut next: Vec<i64> = sub_vertex.iter().map(|&v| if cm.is_boundary_vertex(v) { self.boundary_k[v as usize] as i64 } else { 0 }).collect();
