@@ -561,24 +561,13 @@ impl<'a> ComponentSystem<'a> {
     /// For each `(d, g)` of `free`, the free cluster it belongs to: vertices
     /// joined by free `G` edges (a representative vertex).
     fn free_clusters(&self, free: &[(f64, usize)]) -> Vec<usize> {
-        let nv = self.tree.vertices.len();
-        let mut parent: Vec<usize> = (0..nv).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        let ends = |g: usize| self.mesh.edge_vertices(self.tree.g_edges[g]).map(|v| self.local[v as usize] as usize);
+        let mut clusters = crate::mesh::UnionFind::new(self.tree.vertices.len());
+        let ends = |g: usize| self.mesh.edge_vertices(self.tree.g_edges[g]).map(|v| self.local[v as usize]);
         for &(_, g) in free {
             let [a, b] = ends(g);
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            if ra != rb {
-                parent[ra] = rb;
-            }
+            clusters.union(a, b);
         }
-        free.iter().map(|&(_, g)| find(&mut parent, ends(g)[0])).collect()
+        free.iter().map(|&(_, g)| clusters.find(ends(g)[0]) as usize).collect()
     }
 
     /// The cone index of every local vertex: `k_v = 4 j_v + sum sigma p`

@@ -86,10 +86,18 @@ pub fn face_distortion(mesh: &TriMesh, uv: &[[f64; 2]], s: f64) -> Vec<f64> {
 /// `2 pi - k pi/2` at an interior vertex of cone index `k` for a seamless,
 /// fold-free map.
 pub fn uv_angle_sums(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<f64> {
+    angle_sums(mesh, uv, false)
+}
+
+/// UV corner angles summed per vertex; with `signed`, the angles of
+/// flipped triangles (UV area < 0) count negative.
+fn angle_sums(mesh: &TriMesh, uv: &[[f64; 2]], signed: bool) -> Vec<f64> {
     let mut sums = vec![0.0; mesh.n_vertices()];
     for (f, t) in mesh.faces().iter().enumerate() {
+        let flipped = signed && signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]) < 0.0;
         for k in 0..3 {
-            sums[t[k] as usize] += corner_angle(uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
+            let angle = corner_angle(uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
+            sums[t[k] as usize] += if flipped { -angle } else { angle };
         }
     }
     sums
@@ -98,13 +106,7 @@ pub fn uv_angle_sums(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<f64> {
 /// Interior vertices where the map folds ([`Metrics::wound_vertices`]):
 /// signed UV angle sum off the vertex's cone angle by more than pi.
 pub fn wound_vertices(mesh: &TriMesh, placement: &ConePlacement, uv: &[[f64; 2]]) -> Vec<u32> {
-    let mut sums = vec![0.0; mesh.n_vertices()];
-    for (f, t) in mesh.faces().iter().enumerate() {
-        let sign = if signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]) < 0.0 { -1.0 } else { 1.0 };
-        for k in 0..3 {
-            sums[t[k] as usize] += sign * corner_angle(uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
-        }
-    }
+    let sums = angle_sums(mesh, uv, true);
     let cone_angle = super::seamless::interior_cone_angles(mesh, placement);
     (0..mesh.n_vertices() as u32)
         .filter(|&v| {

@@ -30,10 +30,9 @@ impl ComponentSystem<'_> {
             self.choose_path_integers(&phi, &mut p)?;
         }
         self.accumulate_along_tree(k, &mut p)?;
-        for (g, value) in p.into_iter().enumerate() {
-            self.fixed[g] = value;
-        }
-        self.refactor_and_solve()
+        let before = std::mem::replace(&mut self.fixed, p);
+        // On failure the system is left as it was, so the caller can round instead.
+        self.refactor_and_solve().inspect_err(|_| self.fixed = before)
     }
 
     /// The free leftovers' `p` by least `h~ᵀ G h~` (the objective's harmonic
