@@ -270,6 +270,27 @@ function nativeSamples() {
   return rows;
 }
 
+/** The shared samples with a boundary, for `--boundary free` against the aligned default. */
+const OPEN_SAMPLES = ['bff-hemisphere', 'alligator', 'bff-punctured-torus', 'bff-maze', 'bff-cowhead', 'bff-face'];
+
+/** Open samples natively with the boundary aligned and free (α = 0.01, no features); `--big` adds bff-face ×4. */
+function nativeFreeBoundary() {
+  if (!fs.existsSync(sharedMeshes)) return { skipped: `${sharedMeshes} not found` };
+  const bin = releaseCli();
+  if (bin.skipped) return bin;
+  const rows = [];
+  const inputs = OPEN_SAMPLES.map((name) => ({ name: `${name}.obj`, file: path.join(sharedMeshes, `${name}.obj`) }));
+  if (args.has('--big')) inputs.push({ name: 'bff-face.obj ×4', file: subObj(path.join(sharedMeshes, 'bff-face.obj'), 1).file });
+  for (const { name, file } of inputs) {
+    for (const mode of ['aligned', 'free']) {
+      const j = solveReport(bin, file, ['--boundary', mode]);
+      if (j.skipped) return j;
+      rows.push(solveRow(`file → UVs, boundary ${mode}`, name, j));
+    }
+  }
+  return rows;
+}
+
 /**
  * Growth with mesh size: spot subdivided 0-2 times (0-3 with --big), α = 0.01;
  * a row per size and the fitted exponent e of time ∝ faces^e.
@@ -565,6 +586,7 @@ const BENCHES = [
   { env: 'native', stage: 'solve', run: nativeSolve, enabled: !args.has('--no-native') },
   { env: 'native', stage: 'samples', run: nativeSamples, enabled: !args.has('--no-native') },
   { env: 'native', stage: 'scaling', run: nativeScaling, enabled: !args.has('--no-native') && !quick },
+  { env: 'native', stage: 'free-boundary', run: nativeFreeBoundary, enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'solve', run: wasmNodeSolve, enabled: true },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },

@@ -3,7 +3,7 @@
 //! Errors cross as JS `Error`s carrying the library's one-line message; solve
 //! errors that name mesh elements also carry `location` ([`solve_error`]).
 
-use crate::cones::{self, ComponentPlacement, ConeOptions, ConePlacement, Progress};
+use crate::cones::{self, BoundaryMode, ComponentPlacement, ConeOptions, ConePlacement, Progress};
 use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::{self, ParamOptions, ParamProgress};
 use crate::pipeline::{ConeStage, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
@@ -51,6 +51,7 @@ pub struct MeshSession {
     /// The solve in progress through the `solve_*` steps.
     job: Option<Job>,
     refine: RefineOptions,
+    boundary: BoundaryMode,
 }
 
 /// A solve run in steps: its features, its cone stage and the components placed so far.
@@ -77,7 +78,7 @@ impl MeshSession {
                 (w.positions, w.triangles)
             }
         };
-        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None, refine: RefineOptions::default() })
+        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None, refine: RefineOptions::default(), boundary: BoundaryMode::Aligned })
     }
 
     /// Refinements around cones of angle <= 0 that solves try before they
@@ -85,6 +86,13 @@ impl MeshSession {
     /// alone gives, with the error's location.
     pub fn set_max_cone_refinements(&mut self, n: Option<u32>) {
         self.refine.max_cone_refinements = n.map_or(RefineOptions::default().max_cone_refinements, |n| n as usize);
+    }
+
+    /// Whether later cone placements and solves leave the mesh's boundary
+    /// free (no isolines, no corners; features stay aligned) instead of
+    /// aligning it (the default).
+    pub fn set_free_boundary(&mut self, free: bool) {
+        self.boundary = if free { BoundaryMode::Free } else { BoundaryMode::Aligned };
     }
 
     /// The mesh report (`MeshReport` plus `problem_messages`, one line each).
@@ -314,7 +322,7 @@ impl MeshSession {
         if !(lo..=hi).contains(&alpha_smooth) {
             return Err(JsError::new(&format!("alpha_smooth {alpha_smooth} is outside {lo}..{hi}")));
         }
-        Ok((mesh, features, ConeOptions { alpha_smooth, miq, ..ConeOptions::default() }))
+        Ok((mesh, features, ConeOptions { alpha_smooth, miq, boundary: self.boundary, ..ConeOptions::default() }))
     }
 
     fn valid_mesh(&self) -> Result<&TriMesh, JsError> {

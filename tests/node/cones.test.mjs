@@ -109,3 +109,19 @@ test('sharp curves: filters by curve length and dangling ends, with counts', () 
   assert.ok([...closed.edges].every((e) => kept.has(e)));
   assert.equal(closed.edges.length + closed.stats.pruned_edges, all.length);
 });
+
+test('free boundary: woody (flat, one loop) maps without cones, corners or distortion', () => {
+  const file = sharedMesh('woody');
+  assert.ok(file, 'the shared meshes are present');
+  const session = open(file);
+  const aligned = session.solve(new Uint32Array(), 0.01, false, () => {});
+  assert.ok(aligned.boundary_corners.length > 0 && aligned.metrics.distortion > 1e-3);
+  session.set_free_boundary(true);
+  const free = session.solve(new Uint32Array(), 0.01, false, () => {});
+  assert.equal(free.boundary_corners.length, 0);
+  assert.equal(free.cones.length, 0);
+  assert.ok(free.metrics.distortion < 1e-6, `distortion ${free.metrics.distortion}`);
+  assert.equal(free.metrics.flipped, 0);
+  session.set_free_boundary(false);
+  assert.ok(session.place_cones(new Uint32Array(), 0.01, false, () => {}).boundary_corners.length > 0, 'the setting can be undone');
+});

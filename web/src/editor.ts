@@ -119,6 +119,7 @@ export class Editor {
     alpha: $<HTMLInputElement>('alpha'),
     alphaValue: $<HTMLOutputElement>('alpha-value'),
     miq: $<HTMLInputElement>('miq'),
+    freeBoundary: $<HTMLInputElement>('free-boundary'),
     run: $<HTMLButtonElement>('run-button'),
     cancel: $<HTMLButtonElement>('cancel-button'),
     progress: $('solve-progress'),
@@ -500,9 +501,11 @@ export class Editor {
     const features = m.features?.ids() ?? new Uint32Array(0);
     const alpha = alphaOf(Number(this.el.alpha.value));
     const miq = this.el.miq.checked;
+    const freeBoundary = this.el.freeBoundary.checked;
     const settings = {
       alpha_smooth: alpha,
       miq,
+      boundary: freeBoundary ? 'free' : 'aligned',
       sharp_threshold_degrees: this.el.sharpToggle.checked ? Number(this.el.sharpAngle.value) : null,
       feature_edges: features.length,
     };
@@ -520,7 +523,7 @@ export class Editor {
     try {
       const result = await this.worker.solve(features, alpha, miq, (stage, step, remaining) => {
         if (this.mesh === m) this.setProgress(stage, step, remaining);
-      });
+      }, freeBoundary);
       if (this.mesh !== m) return;
       this.clearResult();
       this.result = result;

@@ -22,7 +22,7 @@ export type Request =
   | { id: number; type: 'sharp'; degrees: number; minEdges: number; closedOnly: boolean }
   // A solve in steps (so that a helper worker can place some components):
   // begin → place every component (here, or in a helper and then add) → finish.
-  | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean; maxConeRefinements?: number | undefined }
+  | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean; freeBoundary?: boolean; maxConeRefinements?: number | undefined }
   /** Places one component; with `share` the result answers `{ bytes }` for `solve-add` elsewhere. */
   | { id: number; type: 'solve-place'; component: number; share: boolean }
   | { id: number; type: 'solve-add'; bytes: Uint8Array }

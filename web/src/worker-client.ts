@@ -183,16 +183,16 @@ export class MeshWorker {
    * (some in a helper worker on large meshes), finish. Progress comes from this
    * worker (and from the helper once this one has nothing left to place).
    */
-  async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn): Promise<SolveResult> {
+  async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn, freeBoundary = false): Promise<SolveResult> {
     const generation = this.restarts;
     /** Throws `Cancelled` once this worker was replaced (cancel or crash) since the solve began. */
     const alive = (): void => {
       if (this.restarts !== generation) throw new Cancelled('cancelled');
     };
-    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq, maxConeRefinements: MeshWorker.maxConeRefinements }, [], onProgress);
+    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq, freeBoundary, maxConeRefinements: MeshWorker.maxConeRefinements }, [], onProgress);
     const queue = Array.from(schedule);
     const total = schedule.length;
-    const helper = this.startHelper(features, alphaSmooth, miq, schedule);
+    const helper = this.startHelper(features, alphaSmooth, miq, freeBoundary, schedule);
     let ownDone = false;
     let helperBusy = false;
     let placed = 0;
@@ -258,7 +258,7 @@ export class MeshWorker {
   }
 
   /** A helper for a solve of `schedule`'s components, or null when one would not pay. */
-  private startHelper(features: Uint32Array, alphaSmooth: number, miq: boolean, schedule: Uint32Array): Helper | null {
+  private startHelper(features: Uint32Array, alphaSmooth: number, miq: boolean, freeBoundary: boolean, schedule: Uint32Array): Helper | null {
     const cores = typeof navigator === 'undefined' ? 2 : (navigator.hardwareConcurrency ?? 2);
     if (schedule.length < 2 || this.openFaces < MeshWorker.helperMinFaces || !this.openFiles || cores < 2) return null;
     this.dropHelper();
@@ -266,7 +266,7 @@ export class MeshWorker {
     const files = copyFiles(this.openFiles);
     const ready = (async () => {
       await worker.send({ type: 'import', files, quiet: true }, files.map((f) => f.bytes));
-      const begun = await worker.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq });
+      const begun = await worker.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq, freeBoundary });
       if (begun.schedule.length !== schedule.length || begun.schedule.some((c, i) => c !== schedule[i])) {
         throw new Error('the helper sees a different mesh');
       }

@@ -31,6 +31,7 @@ interface Session {
   sharp_curves(degrees: number, minEdges: number, closedOnly: boolean): SharpResult;
   solve_begin(features: Uint32Array, alpha: number, miq: boolean): Uint32Array;
   set_max_cone_refinements(n: number | undefined): void;
+  set_free_boundary(free: boolean): void;
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
   solve_add(bytes: Uint8Array): void;
   solve_finish(progress: Progress): unknown;
@@ -133,6 +134,7 @@ function solveStep(req: Extract<Request, { type: 'solve-begin' | 'solve-place' |
     case 'solve-begin': {
       stepsStart = performance.now();
       s.set_max_cone_refinements(req.maxConeRefinements);
+      s.set_free_boundary(req.freeBoundary ?? false);
       const schedule = s.solve_begin(req.features, req.alphaSmooth, req.miq);
       return { value: { schedule }, transfer: [schedule.buffer] };
     }

@@ -4,7 +4,7 @@
 //! arguments after its name, so later commands (`cones`, `solve`) slot into
 //! [`COMMANDS`] and [`run`].
 
-use conemap::cones::{self, ConeOptions, ConePlacement};
+use conemap::cones::{self, BoundaryMode, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;
 use conemap::mesh::{analyze, MeshReport, TriMesh};
 use std::path::Path;
@@ -42,7 +42,7 @@ commands:
 
   cones FILE [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
-             [--no-moves] [--json]
+             [--boundary aligned|free] [--no-moves] [--json]
                        place cones (Myles & Zorin 2013, sections 4-5).
                        --alpha: alpha_smooth, 1e-4..1e3 (default 0.01; 100
                        with --miq). --miq: MIQ emulation (no harmonic
@@ -55,7 +55,10 @@ commands:
                        closed curves and curves that end on other features
                        or boundaries. --features: a JSON file
                        {\"edges\": [[[x,y,z],[x,y,z]], ...]} of feature edges
-                       by end positions. --no-moves: skip the cone-location
+                       by end positions. --boundary free: leave the mesh's
+                       boundary off the isolines (no corners; for scans with
+                       holes and texture atlases; features stay aligned);
+                       default aligned. --no-moves: skip the cone-location
                        optimization. --json prints one JSON object.
                        On a terminal, the stage and its progress (rounding
                        round and integers left, cone-move pass, ARAP and
@@ -64,7 +67,7 @@ commands:
 
   solve FILE -o OUT [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
-             [--no-moves] [--report REPORT.json] [--checker]
+             [--boundary aligned|free] [--no-moves] [--report REPORT.json] [--checker]
                        place cones, compute the seamless parametrization and
                        write the mesh with UVs to OUT: .glb, .gltf (buffer
                        embedded) or .obj, by extension. Vertices are split
@@ -86,7 +89,10 @@ problems), 1 when the input could not be read, parsed or used, 2 for bad usage."
 /// Commands and the flags they accept.
 const COMMANDS: &[(&str, &[&str])] = &[
     ("info", &["--json"]),
-    ("cones", &["--json", "--quiet", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features="]),
+    (
+        "cones",
+        &["--json", "--quiet", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features=", "--boundary="],
+    ),
     (
         "solve",
         &[
@@ -99,6 +105,7 @@ const COMMANDS: &[(&str, &[&str])] = &[
             "--sharp=",
             "--min-feature-length=",
             "--features=",
+            "--boundary=",
             "--report=",
             "-o=",
             "--output=",
@@ -339,7 +346,12 @@ fn cone_options(args: &Args) -> Result<ConeOptions, Failure> {
     if !(lo..=hi).contains(&alpha) {
         return Err(usage(&format!("--alpha {alpha} is outside {lo}..{hi}")));
     }
-    Ok(ConeOptions { alpha_smooth: alpha, miq, optimize_locations: !args.flag("--no-moves"), ..ConeOptions::default() })
+    let boundary = match args.value("--boundary") {
+        None | Some("aligned") => BoundaryMode::Aligned,
+        Some("free") => BoundaryMode::Free,
+        Some(other) => return Err(usage(&format!("--boundary expects aligned or free, got \"{other}\""))),
+    };
+    Ok(ConeOptions { alpha_smooth: alpha, miq, optimize_locations: !args.flag("--no-moves"), boundary, ..ConeOptions::default() })
 }
 
 /// The stage and its progress on one line of standard error, while a long
@@ -440,6 +452,7 @@ fn cones_json(mesh: &TriMesh, features: &FeatureSet, options: &ConeOptions, r: &
         "feature_edges": features.len(),
         "alpha_smooth": options.alpha_smooth,
         "miq": options.miq,
+        "boundary": options.boundary,
         "euler_characteristic": mesh.euler_characteristic(),
         "cones": r.cones,
         "boundary_corners": r.boundary_corners,
@@ -463,7 +476,12 @@ fn print_cones(file: &str, mesh: &TriMesh, features: &FeatureSet, options: &Cone
         r.boundary_corners.len()
     );
     let k_sum: i32 = r.cones.iter().chain(&r.boundary_corners).map(|c| c.k).sum();
-    println!("  sum of k: {k_sum} (4 chi = {})", 4 * mesh.euler_characteristic());
+    if options.boundary == BoundaryMode::Free && !mesh.boundary_loops().is_empty() {
+        // The free boundary's geodesic curvature takes the rest of 4 chi.
+        println!("  sum of k: {k_sum} (free boundary: no corners)");
+    } else {
+        println!("  sum of k: {k_sum} (4 chi = {})", 4 * mesh.euler_characteristic());
+    }
     println!("  energy {:.6}, phi rms {:.6}, {} rounding rounds", r.energy, r.phi_rms, r.rounds);
     let t = &r.timings;
     println!(

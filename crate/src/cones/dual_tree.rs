@@ -42,8 +42,15 @@ pub struct DualTree {
 }
 
 impl DualTree {
-    /// Builds the trees for the component with face `seed`.
-    pub fn new(mesh: &TriMesh, seed: u32) -> DualTree {
+    /// Builds the trees for the component with face `seed`. `free` flags
+    /// the free boundary edges per mesh edge (empty: none). A free edge is
+    /// still a port of the outer node, but its `p` is a continuous unknown
+    /// (see `ComponentSystem`), so the tree hangs from the outer node only
+    /// through aligned edges: one root port per loop that has one (its
+    /// gauge aligns the frame there), or, when no boundary edge is aligned,
+    /// one port of the first loop (an arbitrary gauge: every other cycle
+    /// through the outer node crosses a free port).
+    pub fn new(mesh: &TriMesh, seed: u32, free: &[bool]) -> DualTree {
         let comp = mesh.face_components()[seed as usize];
         let nf = mesh.n_faces();
         let mut parent_he = vec![NONE; nf];
@@ -51,6 +58,7 @@ impl DualTree {
         let mut faces = Vec::new();
         let mut queue = VecDeque::new();
         let in_comp = |f: u32| mesh.face_components()[f as usize] == comp;
+        let is_free = |g: u32| free.get(mesh.edge(g) as usize).copied().unwrap_or(false);
 
         let loops: Vec<&Vec<u32>> = mesh
             .boundary_loops()
@@ -58,10 +66,16 @@ impl DualTree {
             .filter(|lp| in_comp(mesh.twin(lp[0]) / 3))
             .collect();
         let has_boundary = !loops.is_empty();
+        // (loop, its root halfedge) for the loops the tree hangs from.
+        let mut rooted: Vec<(&Vec<u32>, u32)> =
+            loops.iter().filter_map(|lp| lp.iter().find(|&&g| !is_free(g)).map(|&g| (*lp, g))).collect();
+        if rooted.is_empty() && has_boundary {
+            rooted.push((loops[0], loops[0][0]));
+        }
         if has_boundary {
-            for lp in &loops {
-                // Root port: the first boundary halfedge's face halfedge.
-                let root_h = mesh.twin(lp[0]);
+            for (lp, first) in rooted {
+                // Root port: the face halfedge of the loop's first aligned edge.
+                let root_h = mesh.twin(first);
                 let root = root_h / 3;
                 if depth[root as usize] == NONE {
                     parent_he[root as usize] = root_h;
@@ -125,18 +139,57 @@ impl DualTree {
         let mut primal_parent_he = vec![NONE; nv];
         let mut primal_depth = vec![NONE; nv];
         let mut in_tp = vec![false; ne];
-        let root_v = vertices[0];
-        primal_depth[root_v as usize] = 0;
-        let mut vq = VecDeque::from([root_v]);
-        while let Some(v) = vq.pop_front() {
-            for h in mesh.outgoing(v) {
-                let e = mesh.edge(h);
-                let w = mesh.head(h);
-                if !in_t[e as usize] && primal_depth[w as usize] == NONE {
-                    primal_depth[w as usize] = primal_depth[v as usize] + 1;
-                    primal_parent_he[w as usize] = h;
-                    in_tp[e as usize] = true;
-                    vq.push_back(w);
+        let free_start = comp_edges.iter().find(|&&e| free.get(e as usize).copied().unwrap_or(false));
+        if let Some(&e) = free_start {
+            // With a free boundary, T_p runs along the free edges wherever it
+            // can (fewest other edges from a free vertex: a 0-1 breadth-first
+            // search), so a free vertex's parent edge is a free port (no
+            // integer) except where a loop joins the rest.
+            let cost = |e: u32| if free.get(e as usize).copied().unwrap_or(false) { 0 } else { 1 };
+            let root_v = mesh.edge_vertices(e)[0];
+            let mut dist = vec![u32::MAX; nv];
+            let mut done = vec![false; nv];
+            dist[root_v as usize] = 0;
+            primal_depth[root_v as usize] = 0;
+            let mut vq = VecDeque::from([root_v]);
+            while let Some(v) = vq.pop_front() {
+                if std::mem::replace(&mut done[v as usize], true) {
+                    continue;
+                }
+                let ph = primal_parent_he[v as usize];
+                if ph != NONE {
+                    in_tp[mesh.edge(ph) as usize] = true;
+                    primal_depth[v as usize] = primal_depth[mesh.tail(ph) as usize] + 1;
+                }
+                for h in mesh.outgoing(v) {
+                    let e = mesh.edge(h);
+                    let w = mesh.head(h);
+                    let d = dist[v as usize] + cost(e);
+                    if !in_t[e as usize] && !done[w as usize] && d < dist[w as usize] {
+                        dist[w as usize] = d;
+                        primal_parent_he[w as usize] = h;
+                        if cost(e) == 0 {
+                            vq.push_front(w);
+                        } else {
+                            vq.push_back(w);
+                        }
+                    }
+                }
+            }
+        } else {
+            let root_v = vertices[0];
+            primal_depth[root_v as usize] = 0;
+            let mut vq = VecDeque::from([root_v]);
+            while let Some(v) = vq.pop_front() {
+                for h in mesh.outgoing(v) {
+                    let e = mesh.edge(h);
+                    let w = mesh.head(h);
+                    if !in_t[e as usize] && primal_depth[w as usize] == NONE {
+                        primal_depth[w as usize] = primal_depth[v as usize] + 1;
+                        primal_parent_he[w as usize] = h;
+                        in_tp[e as usize] = true;
+                        vq.push_back(w);
+                    }
                 }
             }
         }
@@ -285,7 +338,7 @@ mod tests {
     use crate::cones::test_meshes::{grid, octahedron, square_annulus, torus};
 
     fn check_counts(mesh: &TriMesh, expected_leftovers: usize) {
-        let t = DualTree::new(mesh, 0);
+        let t = DualTree::new(mesh, 0, &[]);
         assert_eq!(t.faces.len(), mesh.n_faces(), "T spans every face");
         let chi = mesh.euler_characteristic();
         let expected_g = t.vertices.len() as i64 - chi + if t.has_boundary { 0 } else { 1 };

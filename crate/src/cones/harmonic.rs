@@ -239,7 +239,7 @@ mod tests {
     use crate::cones::test_meshes::{square_annulus, torus};
 
     fn check(mesh: &TriMesh) {
-        let tree = DualTree::new(mesh, 0);
+        let tree = DualTree::new(mesh, 0, &[]);
         let basis = HarmonicBasis::new(mesh, &tree).unwrap();
         assert_eq!(basis.len(), tree.leftovers.len());
         // Closed: every vertex cycle integral vanishes.

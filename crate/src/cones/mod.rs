@@ -58,6 +58,22 @@ pub struct ConeOptions {
     pub coarse_vertices: usize,
     /// How Algorithm 1 batches its fixes.
     pub rounding: RoundingRule,
+    /// Whether the mesh's own boundary is held on isolines.
+    pub boundary: BoundaryMode,
+}
+
+/// What the boundary of the input mesh must do (features are always aligned).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BoundaryMode {
+    /// Every boundary edge on a u or v isoline, with corners of k·90° (the
+    /// paper's setting: CAD parts, deliberate cuts).
+    #[default]
+    Aligned,
+    /// The boundary is left free: no isoline, no corners, its geodesic
+    /// curvature outside the constraints (scans with holes, atlases). The
+    /// holonomy around each hole is still a multiple of 90° (seamless).
+    Free,
 }
 
 /// How each round of Algorithm 1 picks the `p` to fix (see
@@ -84,6 +100,7 @@ impl Default for ConeOptions {
             cancel_pairs_nearest: 3,
             coarse_vertices: COARSE_VERTICES,
             rounding: RoundingRule::PerCluster,
+            boundary: BoundaryMode::Aligned,
         }
     }
 }
@@ -259,8 +276,12 @@ fn original_cones(mesh: &TriMesh, cut: &CutMesh, k: &[i32]) -> (Vec<Cone>, Vec<C
         }
     }
     let (mut cones, mut corners) = (Vec::new(), Vec::new());
+    let free_boundary = cut.has_free_boundary();
     for v in 0..n as u32 {
         let i = v as usize;
+        if free_boundary && mesh.is_boundary_vertex(v) {
+            continue; // a free boundary has no corners
+        }
         let total = if cut_interior[i] {
             sum[i]
         } else if mesh.is_boundary_vertex(v) {

@@ -7,7 +7,7 @@
 
 use super::frames::{Frames, Visit};
 use super::system::{ComponentSystem, Weights};
-use super::{original_cones, ComponentCones, ConeError, ConeOptions, ConePlacement, ConeTimings, Progress};
+use super::{original_cones, BoundaryMode, ComponentCones, ConeError, ConeOptions, ConePlacement, ConeTimings, Progress};
 use crate::clock::Stopwatch;
 use crate::features::{boundary_turning, cut_open, CutMesh, FeatureSet};
 use crate::mesh::{decimate_interior, TriMesh};
@@ -111,7 +111,10 @@ impl ConeProblem {
     /// Cuts `mesh` open along `features` and prepares the shared data.
     pub fn new(mesh: &TriMesh, features: &FeatureSet, options: &ConeOptions) -> ConeProblem {
         let mut clock = Stopwatch::start();
-        let cut = cut_open(mesh, features);
+        let mut cut = cut_open(mesh, features);
+        if options.boundary == BoundaryMode::Free {
+            cut.free_original_boundary(mesh);
+        }
         let cm = &cut.mesh;
         let frames = Frames::new(cm);
         let boundary_k = boundary_turning(cm);
@@ -153,7 +156,7 @@ impl ConeProblem {
         let (cm, frames, options) = (&self.cut.mesh, &self.frames, &self.options);
         let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
         progress(Progress::Topology { component: c, components: self.n_components() });
-        let mut sys = ComponentSystem::new(cm, frames, self.seeds[c], &self.boundary_k, weights)?;
+        let mut sys = ComponentSystem::new(cm, frames, self.seeds[c], &self.boundary_k, &self.cut.free, weights)?;
         sys.rounding = options.rounding;
         let topology_seconds = clock.lap();
         let mut rounds = None;
@@ -283,8 +286,16 @@ impl ConeProblem {
         for (mesh, to_sub) in levels.iter().rev() {
             let to_cut = |v: u32| sub_vertex[to_sub[v as usize] as usize];
             let boundary_k: Vec<i32> = (0..mesh.n_vertices() as u32).map(|v| self.boundary_k[to_cut(v) as usize]).collect();
+            // Boundary edges are kept by the decimation: free where the cut mesh's are.
+            let free: Vec<bool> = (0..mesh.n_edges() as u32)
+                .map(|e| {
+                    let [a, b] = mesh.edge_vertices(e).map(to_cut);
+                    mesh.is_boundary_edge(e)
+                        && cm.outgoing(a).find(|&h| cm.head(h) == b).is_some_and(|h| self.cut.free[cm.edge(h) as usize])
+                })
+                .collect();
             let frames = Frames::new(mesh);
-            let mut lsys = ComponentSystem::new(mesh, &frames, 0, &boundary_k, weights).ok()?;
+            let mut lsys = ComponentSystem::new(mesh, &frames, 0, &boundary_k, &free, weights).ok()?;
             lsys.rounding = options.rounding;
             match &k_sub {
                 None => {

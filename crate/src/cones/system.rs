@@ -64,6 +64,9 @@ struct VertexCycle {
     transport: f64,
     /// `j_v`: `(K_v - transport) / 2 pi`, an integer.
     j: i64,
+    /// True when the cycle crosses a free port: the row holds for any
+    /// `phi` (its continuous `p` absorbs it) and the vertex has no index.
+    free: bool,
 }
 
 /// Settings of one solve.
@@ -88,6 +91,10 @@ pub struct ComponentSystem<'a> {
     total_area: f64,
     /// Fixed value of each `p` (`None` while free).
     pub fixed: Vec<Option<i64>>,
+    /// Per `G` edge: true for a port of a free boundary edge, whose `p` is
+    /// a continuous unknown, never rounded (the frame need not turn with
+    /// the boundary there).
+    continuous: Vec<bool>,
     n: usize,
     row_fix: usize,
     constraint_rhs: Vec<f64>,
@@ -150,15 +157,17 @@ impl std::error::Error for ConeError {}
 impl<'a> ComponentSystem<'a> {
     /// Builds and factorizes the system for the component containing face
     /// `seed`; boundary vertices get the turning integers of `boundary_k`
-    /// (indexed by mesh vertex).
+    /// (indexed by mesh vertex), except where they end a free boundary edge
+    /// (`free`, per mesh edge; empty: none free).
     pub fn new(
         mesh: &'a TriMesh,
         frames: &Frames,
         seed: u32,
         boundary_k: &[i32],
+        free: &[bool],
         weights: Weights,
     ) -> Result<Self, ConeError> {
-        let tree = DualTree::new(mesh, seed);
+        let tree = DualTree::new(mesh, seed, free);
         let basis = HarmonicBasis::new(mesh, &tree)?;
         let nv = tree.vertices.len();
         let nh = basis.len();
@@ -189,6 +198,8 @@ impl<'a> ComponentSystem<'a> {
             .map(|(i, &v)| if mesh.is_boundary_vertex(v) { PI } else { 2.0 * PI } - angle_sum[i])
             .collect();
 
+        let continuous: Vec<bool> =
+            tree.g_edges.iter().map(|&e| free.get(e as usize).copied().unwrap_or(false)).collect();
         // Vertex cycles in the path basis.
         let cycles: Vec<VertexCycle> = tree
             .vertices
@@ -198,13 +209,16 @@ impl<'a> ComponentSystem<'a> {
                 let cycle = vertex_cycle(mesh, v);
                 let transport = frames.cycle_transport(mesh, &cycle);
                 let j = ((defect[i] - transport) / (2.0 * PI)).round() as i64;
-                VertexCycle { g: cycle_signs(mesh, &tree, &cycle), transport, j }
+                let g = cycle_signs(mesh, &tree, &cycle);
+                let free = g.iter().any(|&(g, _)| continuous[g as usize]);
+                VertexCycle { g, transport, j, free }
             })
             .collect();
 
         // Boundary turning: peel what determines single p's, pin the rest.
         let mut fixed: Vec<Option<i64>> = vec![None; ng];
-        let mut pending: Vec<usize> = (0..nv).filter(|&i| mesh.is_boundary_vertex(tree.vertices[i])).collect();
+        let mut pending: Vec<usize> =
+            (0..nv).filter(|&i| mesh.is_boundary_vertex(tree.vertices[i]) && !cycles[i].free).collect();
         let target = |i: usize| boundary_k[tree.vertices[i] as usize] as i64 - 4 * cycles[i].j;
         loop {
             let mut progress = false;
@@ -350,6 +364,7 @@ impl<'a> ComponentSystem<'a> {
             area,
             total_area,
             fixed,
+            continuous,
             n,
             row_fix,
             constraint_rhs: rhs,
@@ -369,6 +384,11 @@ impl<'a> ComponentSystem<'a> {
             curvature: None,
             rounding: RoundingRule::PerCluster,
         })
+    }
+
+    /// True when the component has free boundary edges (continuous `p`).
+    pub fn has_free_boundary(&self) -> bool {
+        self.continuous.iter().any(|&c| c)
     }
 
     fn p0(&self) -> usize {
@@ -400,6 +420,16 @@ impl<'a> ComponentSystem<'a> {
                 }
                 other => return other,
             }
+        }
+    }
+
+    /// Refactorizes when fixes are bordered, so that blocked solves with the
+    /// factorization alone see every fix.
+    fn refactor_if_bordered(&mut self) -> Result<(), ConeError> {
+        if self.border.is_empty() {
+            Ok(())
+        } else {
+            self.refactor_and_solve()
         }
     }
 
@@ -507,7 +537,7 @@ impl<'a> ComponentSystem<'a> {
                 .fixed
                 .iter()
                 .enumerate()
-                .filter(|(_, f)| f.is_none())
+                .filter(|&(g, f)| f.is_none() && !self.continuous[g])
                 .map(|(g, _)| {
                     let v = self.x[p0 + g];
                     ((v - v.round()).abs(), g)
@@ -559,11 +589,13 @@ impl<'a> ComponentSystem<'a> {
     }
 
     /// For each `(d, g)` of `free`, the free cluster it belongs to: vertices
-    /// joined by free `G` edges (a representative vertex).
+    /// joined by free `G` edges or along a free boundary (a representative
+    /// vertex).
     fn free_clusters(&self, free: &[(f64, usize)]) -> Vec<usize> {
         let mut clusters = crate::mesh::UnionFind::new(self.tree.vertices.len());
         let ends = |g: usize| self.mesh.edge_vertices(self.tree.g_edges[g]).map(|v| self.local[v as usize]);
-        for &(_, g) in free {
+        let continuous = (0..self.continuous.len()).filter(|&g| self.continuous[g]);
+        for g in free.iter().map(|&(_, g)| g).chain(continuous) {
             let [a, b] = ends(g);
             clusters.union(a, b);
         }
@@ -640,9 +672,13 @@ impl<'a> ComponentSystem<'a> {
         (0..self.area.len()).map(|i| v(i) * v(i) * self.area[i]).sum::<f64>() / self.total_area
     }
 
-    /// The cone index of local vertex `i` (all `p` on its cycle fixed).
+    /// The cone index of local vertex `i` (all `p` on its cycle fixed; 0 on
+    /// a free boundary).
     pub fn vertex_k_at(&self, i: usize) -> i64 {
         let c = &self.cycles[i];
+        if c.free {
+            return 0;
+        }
         4 * c.j + c.g.iter().map(|&(g, s)| s as i64 * self.fixed[g as usize].unwrap_or(0)).sum::<i64>()
     }
 }
@@ -653,7 +689,7 @@ impl<'a> ComponentSystem<'a> {
 pub(crate) fn test_system(mesh: &TriMesh) -> ComponentSystem<'_> {
     let frames = Frames::new(mesh);
     let boundary_k = crate::features::boundary_turning(mesh);
-    ComponentSystem::new(mesh, &frames, 0, &boundary_k, Weights { alpha_smooth: 0.01, miq: false }).unwrap()
+    ComponentSystem::new(mesh, &frames, 0, &boundary_k, &[], Weights { alpha_smooth: 0.01, miq: false }).unwrap()
 }
 
 /// The `G` edges a cycle crosses, with the sign `+1` when the cycle crosses

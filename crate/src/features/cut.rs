@@ -14,6 +14,10 @@ pub struct CutMesh {
     pub original_vertex: Vec<u32>,
     /// Cut edge → edge of the original mesh.
     pub original_edge: Vec<u32>,
+    /// Per cut edge: true for a boundary edge of the original mesh left free
+    /// ([`CutMesh::free_original_boundary`]): not held on an isoline, and
+    /// its end vertices get no corner.
+    pub free: Vec<bool>,
 }
 
 impl CutMesh {
@@ -21,6 +25,30 @@ impl CutMesh {
     /// (rather than from a boundary of the original mesh).
     pub fn is_feature_edge(&self, original: &TriMesh, e: u32) -> bool {
         self.mesh.is_boundary_edge(e) && !original.is_boundary_edge(self.original_edge[e as usize])
+    }
+
+    /// Frees the boundary of the original mesh (feature edges stay aligned).
+    pub fn free_original_boundary(&mut self, original: &TriMesh) {
+        self.free = (0..self.mesh.n_edges() as u32)
+            .map(|e| self.mesh.is_boundary_edge(e) && original.is_boundary_edge(self.original_edge[e as usize]))
+            .collect();
+    }
+
+    /// True when some edges are free.
+    pub fn has_free_boundary(&self) -> bool {
+        self.free.iter().any(|&f| f)
+    }
+
+    /// True when the edge of halfedge `h` is a boundary edge of the cut mesh
+    /// that must lie on an isoline (a feature, or an aligned boundary).
+    pub fn is_aligned_halfedge(&self, h: u32) -> bool {
+        let e = self.mesh.edge(h);
+        self.mesh.is_boundary_edge(e) && !self.free[e as usize]
+    }
+
+    /// True when vertex `v` of the cut mesh ends a free edge.
+    pub fn touches_free(&self, v: u32) -> bool {
+        self.mesh.outgoing(v).any(|h| self.free[self.mesh.edge(h) as usize])
     }
 }
 
@@ -74,7 +102,8 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
             mesh.edge(h) // face halfedge numbering is shared (3 f + k)
         })
         .collect();
-    CutMesh { mesh: cut, original_vertex, original_edge }
+    let free = vec![false; cut.n_edges()];
+    CutMesh { mesh: cut, original_vertex, original_edge, free }
 }
 
 

@@ -29,8 +29,8 @@ pub struct CrossField {
     /// Per face halfedge `h` of an interior edge of the original mesh:
     /// `m` with `beta[twin h] = beta[h] + kappa(h) + m pi/2` (eq. 21); 0 on boundary.
     pub matching: Vec<i64>,
-    /// Per face halfedge whose edge is a boundary of the cut mesh (feature or
-    /// boundary): the UV coordinate that is constant along it (0 = u, 1 = v);
+    /// Per face halfedge whose edge is an aligned boundary of the cut mesh
+    /// (feature, or boundary unless free): the UV coordinate that is constant along it (0 = u, 1 = v);
     /// [`NO_ISOLINE`] elsewhere.
     pub isoline: Vec<u8>,
     /// Largest deviation from an integer seen among matchings and alignments (quarter turns).
@@ -53,10 +53,11 @@ impl CrossField {
 }
 
 /// Propagates `beta` over a breadth-first dual spanning tree of every
-/// component of the cut mesh (starting at a boundary edge of the cut mesh
-/// with `beta` = the edge angle, or at face 0's first edge on a closed
-/// component), then measures the matchings on every interior edge of the
-/// ORIGINAL mesh and the alignment on every cut-mesh boundary edge.
+/// component of the cut mesh (starting at an aligned boundary edge of the
+/// cut mesh with `beta` = the edge angle, or at the component's first edge
+/// when none is aligned), then measures the matchings on every interior
+/// edge of the ORIGINAL mesh and the alignment on every aligned boundary
+/// edge (features, and the boundary unless it is free).
 ///
 /// Errors: [`ParamError::NonIntegerMatching`] / [`ParamError::Misaligned`]
 /// when a value is more than [`INTEGER_TOLERANCE`] from an integer.
@@ -71,14 +72,14 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
     let mut roots = Vec::new();
     let mut queue = VecDeque::new();
 
-    // Seeds: one per component of the cut mesh, preferring a boundary edge.
+    // Seeds: one per component of the cut mesh, preferring an aligned edge.
     let comps = cm.face_components();
     let n_comp = cm.n_components();
     let mut seed: Vec<Option<u32>> = vec![None; n_comp];
+    let aligned = |s: u32| placement.cut.is_aligned_halfedge(s);
     for h in 0..3 * nf as u32 {
         let c = comps[(h / 3) as usize] as usize;
-        let on_boundary = |s: u32| cm.is_boundary_halfedge(cm.twin(s));
-        if seed[c].is_none_or(|s| on_boundary(h) && !on_boundary(s)) {
+        if seed[c].is_none_or(|s| aligned(h) && !aligned(s)) {
             seed[c] = Some(h);
         }
     }
@@ -87,8 +88,8 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
         if visited[f] {
             continue;
         }
-        // Aligned with the edge when it is a boundary; any value on a closed component.
-        beta[s as usize] = if cm.is_boundary_halfedge(cm.twin(s)) { frames.halfedge_angle(mesh, s) } else { 0.0 };
+        // Aligned with the edge when it must be; any value where no edge is aligned.
+        beta[s as usize] = if aligned(s) { frames.halfedge_angle(mesh, s) } else { 0.0 };
         visited[f] = true;
         roots.push(f as u32);
         queue.push_back(s);
@@ -138,7 +139,7 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
     }
     let mut isoline = vec![NO_ISOLINE; 3 * nf];
     for h in 0..3 * nf as u32 {
-        if !cm.is_boundary_halfedge(cm.twin(h)) {
+        if !aligned(h) {
             continue;
         }
         let n = (beta[h as usize] - frames.halfedge_angle(mesh, h)) / FRAC_PI_2;

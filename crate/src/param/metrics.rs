@@ -207,10 +207,9 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
         seam_length += ((p[0][0] - p[1][0]).powi(2) + (p[0][1] - p[1][1]).powi(2) + (p[0][2] - p[1][2]).powi(2)).sqrt();
     }
 
-    let cm = &placement.cut.mesh;
     let mut alignment = 0.0f64;
     for h in 0..3 * nf as u32 {
-        if cm.is_boundary_halfedge(cm.twin(h)) {
+        if placement.cut.is_aligned_halfedge(h) {
             let (p, q) = (uv[h as usize], uv[mesh.next(h) as usize]);
             let ang = (q[1] - p[1]).atan2(q[0] - p[0]);
             alignment = alignment.max(axis_deviation(ang));

@@ -285,6 +285,9 @@ fn realized_cones(placement: &ConePlacement, sys: &System, uv: &[[f64; 2]], cone
     }
     let mut out = Vec::new();
     for (cv, &sum) in sums.iter().enumerate() {
+        if placement.cut.touches_free(cv as u32) {
+            continue; // a free boundary vertex has no prescribed angle
+        }
         let boundary = cm.is_boundary_vertex(cv as u32);
         let full = if boundary { PI } else { 2.0 * PI };
         let k = ((full - sum) / FRAC_PI_2).round() as i32;

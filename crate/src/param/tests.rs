@@ -125,3 +125,79 @@ fn folded_arap_map_is_repaired_and_refined_without_flips() {
     assert!(after.metrics.distortion < before.metrics.distortion, "{} vs {}", after.metrics.distortion, before.metrics.distortion);
     eprintln!("annulus: distortion {:.4} -> {:.4}", before.metrics.distortion, after.metrics.distortion);
 }
+
+fn run_free(mesh: &TriMesh, features: &FeatureSet) -> (ConePlacement, Parametrization) {
+    let options = ConeOptions { boundary: crate::cones::BoundaryMode::Free, ..ConeOptions::default() };
+    let placement = place_cones(mesh, features, &options, &mut |_| {}).expect("cones");
+    let p = parametrize(mesh, &placement, &ParamOptions::default(), &mut |_| {}).expect("param");
+    (placement, p)
+}
+
+/// Largest angle between a boundary edge's UV image and the nearest axis.
+fn boundary_axis_deviation(mesh: &TriMesh, p: &Parametrization) -> f64 {
+    (0..3 * mesh.n_faces() as u32)
+        .filter(|&h| mesh.is_boundary_halfedge(mesh.twin(h)))
+        .map(|h| {
+            let (a, b) = (p.uv[h as usize], p.uv[mesh.next(h) as usize]);
+            let ang = (b[1] - a[1]).atan2(b[0] - a[0]).rem_euclid(FRAC_PI_2);
+            ang.min(FRAC_PI_2 - ang)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_flat_patch_with_a_free_boundary_maps_isometrically() {
+    // Planar with curved sides: aligned, its boundary must straighten (distortion);
+    // free, the map is the patch itself up to a rigid motion and scale.
+    let mesh = grid(12, 8, |x, y| [x + 0.4 * y * y, y + 0.2 * x * x, 0.0]);
+    let (placement, p) = run_free(&mesh, &FeatureSet::none(&mesh));
+    assert_eq!(placement.cones.len(), 0);
+    assert!(placement.boundary_corners.is_empty(), "a free boundary has no corners");
+    assert!(p.metrics.distortion < 1e-6, "distortion {}", p.metrics.distortion);
+    assert!(boundary_axis_deviation(&mesh, &p) > 0.1, "the sheared boundary is left off the axes");
+    let aligned = run(&mesh, &FeatureSet::none(&mesh)).1;
+    assert!(aligned.metrics.distortion > 1e-3, "aligned, the same strip distorts ({})", aligned.metrics.distortion);
+}
+
+#[test]
+fn a_free_annulus_is_seamless_around_its_hole() {
+    // Two free loops: the holonomy around the hole is a multiple of 90°
+    // (seamless across the cut joining the loops), nothing else is constrained.
+    let mesh = crate::cones::test_meshes::square_annulus(8, 4, 0.4, 20f64.to_radians());
+    let (placement, p) = run_free(&mesh, &FeatureSet::none(&mesh));
+    assert!(placement.boundary_corners.is_empty());
+    let m = &p.metrics;
+    assert!(m.seam_angle_residual < 1e-9 && m.seam_length_residual < 1e-9, "seams {} {}", m.seam_angle_residual, m.seam_length_residual);
+    assert_eq!((m.flipped, m.wound_vertices), (0, 0));
+    let sums = metrics::uv_angle_sums(&mesh, &p.uv);
+    for c in &placement.cones {
+        let expected = 2.0 * PI - c.k as f64 * FRAC_PI_2;
+        assert!((sums[c.vertex as usize] - expected).abs() < 1e-6, "cone {}: angle sum {}", c.vertex, sums[c.vertex as usize]);
+    }
+}
+
+#[test]
+fn features_stay_aligned_on_a_free_boundary() {
+    // A feature line across a bumpy sheet, ending on the free boundary.
+    let mesh = grid(10, 10, |x, y| [x, y, 0.15 * (3.0 * x).sin() * (2.0 * y).cos()]);
+    let mut features = FeatureSet::none(&mesh);
+    for e in 0..mesh.n_edges() as u32 {
+        if mesh.edge_vertices(e).iter().all(|&v| (mesh.position(v)[0] - 0.5).abs() < 1e-12) {
+            features.set(&mesh, e, true);
+        }
+    }
+    assert!(features.len() >= 9);
+    let (placement, p) = run_free(&mesh, &features);
+    let m = &p.metrics;
+    assert!(m.alignment_residual < 1e-9, "feature alignment {}", m.alignment_residual);
+    assert!(m.seam_angle_residual < 1e-9, "seams {}", m.seam_angle_residual);
+    assert_eq!(m.flipped, 0);
+    assert!(placement.boundary_corners.is_empty());
+    for e in 0..mesh.n_edges() as u32 {
+        if features.contains(e) {
+            let h = mesh.edge_halfedges(e)[0];
+            let (a, b) = (p.uv[h as usize], p.uv[mesh.next(h) as usize]);
+            assert!((a[0] - b[0]).abs() < 1e-9 || (a[1] - b[1]).abs() < 1e-9, "feature edge {e} off the axes");
+        }
+    }
+}

@@ -20,6 +20,9 @@ impl ComponentSystem<'_> {
     /// solves. Errs with [`ConeError::InconsistentBoundary`] when `k`
     /// contradicts the boundary fixes or does not sum to `4 chi`.
     pub fn fix_indices(&mut self, k: &[i64]) -> Result<(), ConeError> {
+        if self.has_free_boundary() {
+            return self.fix_indices_free(k);
+        }
         let nv = self.tree.vertices.len();
         let nh = self.basis.len();
         // phi from the curvature equation.
@@ -33,6 +36,17 @@ impl ComponentSystem<'_> {
         let before = std::mem::replace(&mut self.fixed, p);
         // On failure the system is left as it was, so the caller can round instead.
         self.refactor_and_solve().inspect_err(|_| self.fixed = before)
+    }
+
+    /// [`Self::fix_indices`] on a component with a free boundary, where the
+    /// curvature equation does not hold `phi`: the `p` that the indices
+    /// determine are fixed, and the rest (the leftovers, and the tree path
+    /// from where a second free loop joins `T_p`) are rounded by Algorithm 1.
+    fn fix_indices_free(&mut self, k: &[i64]) -> Result<(), ConeError> {
+        let mut p: Vec<Option<i64>> = self.fixed.clone();
+        self.accumulate_along_tree(k, &mut p)?;
+        let before = std::mem::replace(&mut self.fixed, p);
+        self.round_all(&mut |_, _| {}).inspect_err(|_| self.fixed = before)
     }
 
     /// The free leftovers' `p` by least `h~ᵀ G h~` (the objective's harmonic
@@ -83,22 +97,36 @@ impl ComponentSystem<'_> {
 
     /// The `p` of `T_p` from `k`, leaves first: vertex `i`'s row
     /// `sum sigma p = k_i - 4 j_i` has its parent edge as the one unknown.
+    /// On a free boundary there is no row; a `p` left unknown there leaves
+    /// the rows above it unknown too (they stay free).
     fn accumulate_along_tree(&self, k: &[i64], p: &mut [Option<i64>]) -> Result<(), ConeError> {
         let nv = self.tree.vertices.len();
         let mut order: Vec<usize> = (0..nv).collect();
         order.sort_by_key(|&i| std::cmp::Reverse(self.tree.primal_depth[self.tree.vertices[i] as usize]));
         let inconsistent = |i: usize| ConeError::InconsistentBoundary { vertex: self.tree.vertices[i] };
+        let free_boundary = self.has_free_boundary();
         for &i in &order {
             let h = self.tree.primal_parent_he[self.tree.vertices[i] as usize];
             let parent_g = if h == NONE { None } else { Some(self.tree.g_index[self.mesh.edge(h) as usize]) };
+            if self.cycles[i].free {
+                continue;
+            }
             let mut rest = 0i64;
             let mut own = None;
+            let mut unknown = false;
             for &(g, s) in &self.cycles[i].g {
                 if Some(g) == parent_g {
                     own = Some(s as i64);
                     continue;
                 }
-                rest += s as i64 * p[g as usize].ok_or_else(|| inconsistent(i))?;
+                match p[g as usize] {
+                    Some(value) => rest += s as i64 * value,
+                    None if free_boundary => unknown = true,
+                    None => return Err(inconsistent(i)),
+                }
+            }
+            if unknown {
+                continue;
             }
             let target = k[i] - 4 * self.cycles[i].j - rest;
             match (parent_g, own) {

@@ -33,7 +33,8 @@ impl ComponentSystem<'_> {
 
     /// The changes `(g, Δp_g)` of the fixed `p` that move `amount` quarter
     /// turns of cone index from local vertex `from` to `to` along `T_p`
-    /// (leftovers are never on it).
+    /// (leftovers are never on it; a free port on the way is a continuous
+    /// unknown, which takes the index in and gives it back unchanged).
     fn transfer_changes(&self, (from, to, amount): Transfer) -> Vec<(usize, i64)> {
         let (a, b) = (self.tree.vertices[from], self.tree.vertices[to]);
         let mut x = a;
@@ -41,8 +42,10 @@ impl ComponentSystem<'_> {
         for (e, _) in self.tree.primal_path(self.mesh, a, b) {
             let [u, w] = self.mesh.edge_vertices(e);
             let g = self.tree.g_index[e as usize];
-            let s = self.sigma(self.local[x as usize] as usize, g).expect("T_p edges are G edges of both end vertices") as i64;
-            out.push((g as usize, -amount * s));
+            if !self.continuous[g as usize] {
+                let s = self.sigma(self.local[x as usize] as usize, g).expect("T_p edges are G edges of both end vertices") as i64;
+                out.push((g as usize, -amount * s));
+            }
             x = if u == x { w } else { u };
         }
         out
@@ -76,6 +79,9 @@ impl ComponentSystem<'_> {
     /// For each set of transfers, the change of `[phi; h~]` that making them
     /// all would bring (column-major, [`Self::response_width`] per set).
     fn responses(&mut self, sets: &[Vec<Transfer>]) -> Result<Vec<f64>, ConeError> {
+        if self.has_free_boundary() {
+            return self.kkt_responses(sets);
+        }
         let nv = self.tree.vertices.len();
         let mut db = vec![0.0; nv * sets.len()];
         for (col, set) in sets.iter().enumerate() {
@@ -106,9 +112,66 @@ impl ComponentSystem<'_> {
     /// `u` to `w` (along `T_p`, as [`Self::transfer`] does) changes the
     /// energy by about `2 a (Phi[w] - Phi[u])` (one curvature solve).
     fn move_potential(&mut self) -> Result<Vec<f64>, ConeError> {
+        if self.has_free_boundary() {
+            return self.kkt_move_potential();
+        }
         let phi = self.x[..self.tree.vertices.len()].to_vec();
         // A ranking needs no more than the trials' accuracy.
         Ok(self.curvature()?.move_potential(&phi, TRIAL_TOLERANCE)?)
+    }
+
+    /// [`Self::responses`] through the full KKT, for components with a free
+    /// boundary: there `phi` on the boundary is an unknown of the objective
+    /// (no vertex row holds it), so the curvature equation alone does not
+    /// determine it. A transfer changes fix rows' right-hand sides only, so
+    /// its response is `K⁻¹ Δb` with the factorization of the final integers.
+    fn kkt_responses(&mut self, sets: &[Vec<Transfer>]) -> Result<Vec<f64>, ConeError> {
+        self.refactor_if_bordered()?;
+        let (dim, width, fix0) = (self.kkt.pattern.dim(), self.response_width(), self.n + self.row_fix);
+        let mut rhs = vec![0.0; dim * sets.len()];
+        for (col, set) in sets.iter().enumerate() {
+            for &t in set {
+                for (g, dp) in self.transfer_changes(t) {
+                    rhs[col * dim + fix0 + g] += dp as f64;
+                }
+            }
+        }
+        let (x, _) = self.solver.solve_many_to(&rhs, sets.len(), TRIAL_TOLERANCE)?;
+        Ok(x.chunks(dim).flat_map(|c| c[..width].iter().copied()).collect())
+    }
+
+    /// [`Self::move_potential`] through the full KKT: with
+    /// `y = K⁻¹ [M phi / A; 0]`, changing fixed `p_g` by `Δ` changes
+    /// `phiᵀ M phi / A` by about `2 y_g Δ` (`y_g` at `p_g`'s fix row), and
+    /// the potential accumulates these along `T_p` from its root.
+    fn kkt_move_potential(&mut self) -> Result<Vec<f64>, ConeError> {
+        self.refactor_if_bordered()?;
+        let nv = self.tree.vertices.len();
+        let dim = self.kkt.pattern.dim();
+        let mut rhs = vec![0.0; dim];
+        for i in 0..nv {
+            rhs[i] = self.x[i] * self.area[i] / self.total_area;
+        }
+        let (y, _) = self.solver.solve_many_to(&rhs, 1, TRIAL_TOLERANCE)?;
+        let fix0 = self.n + self.row_fix;
+        let mut order: Vec<usize> = (0..nv).collect();
+        order.sort_by_key(|&i| self.tree.primal_depth[self.tree.vertices[i] as usize]);
+        let mut potential = vec![0.0; nv];
+        for i in order {
+            let h = self.tree.primal_parent_he[self.tree.vertices[i] as usize];
+            if h == crate::mesh::NONE {
+                continue;
+            }
+            let parent = self.local[self.mesh.tail(h) as usize] as usize;
+            let g = self.tree.g_index[self.mesh.edge(h) as usize];
+            potential[i] = potential[parent];
+            if !self.continuous[g as usize] {
+                // A unit transfer parent -> i changes p_g by -sigma(parent, g).
+                let s = self.sigma(parent, g).expect("T_p edges are G edges of both end vertices");
+                potential[i] -= s as f64 * y[fix0 + g as usize];
+            }
+        }
+        Ok(potential)
     }
 
     /// Cone-location optimization (section 5.3): moves an interior cone to
@@ -411,6 +474,35 @@ mod tests {
         for i in 0..width {
             let exact = sys.x[i] - before[i];
             assert!((exact - dx[i]).abs() < 1e-7 * scale, "unknown {i}: KKT {exact} vs curvature {}", dx[i]);
+        }
+    }
+
+    /// The KKT responses and move potential (used on free boundaries) are
+    /// the curvature system's where both apply.
+    #[test]
+    fn kkt_responses_and_potential_match_the_curvature_system() {
+        let mesh = square_annulus(6, 4, 0.4, 30f64.to_radians());
+        let mut sys = test_system(&mesh);
+        sys.round_all(&mut |_, _| {}).unwrap();
+        let nv = sys.tree.vertices.len();
+        let interior: Vec<usize> = (0..nv).filter(|&i| !mesh.is_boundary_vertex(sys.tree.vertices[i])).collect();
+        let sets = vec![vec![(interior[1], interior[interior.len() - 2], 1)], vec![(interior[interior.len() / 2], interior[0], -2)]];
+        let curvature = sys.responses(&sets).unwrap();
+        let kkt = sys.kkt_responses(&sets).unwrap();
+        let scale = curvature.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        assert!(scale > 1e-6);
+        for (i, (a, b)) in curvature.iter().zip(&kkt).enumerate() {
+            assert!((a - b).abs() < 1e-7 * scale, "entry {i}: curvature {a} vs KKT {b}");
+        }
+        let (p1, p2) = (sys.move_potential().unwrap(), sys.kkt_move_potential().unwrap());
+        // Potentials agree up to a constant (only differences are used).
+        let (d1, d2) = (p1[interior[0]] - p1[interior[3]], p2[interior[0]] - p2[interior[3]]);
+        let pscale = p1.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        assert!(d1.abs() > 1e-9 * pscale);
+        for &i in &interior {
+            let (a, b) = (p1[i] - p1[interior[0]], p2[i] - p2[interior[0]]);
+            // A ranking heuristic: its multipliers are solved less tightly than x.
+            assert!((a - b).abs() < 1e-4 * pscale, "vertex {i}: potential {a} vs {b} ({d1} {d2})");
         }
     }
 
