@@ -4,6 +4,8 @@
 //   npm run bench                     (setup + build + this script)
 //   node scripts/bench.mjs [--no-native] [--no-browser] [--quick] [--big] [--only ENV:STAGE,...]
 //   (--big adds spot subdivided three times, 375 k faces, to native:scaling)
+//   browser:solve-big / browser:solve-single: Run in the page on 207 k faces with
+//   features, and on spot ×16 / fandisk ×16 without (issue 13's page targets)
 //
 // Each entry of BENCHES is { env, stage, run(ctx) } and returns rows
 // { input, faces?, ms, runs?, note? } (env/stage are filled in). Later pipeline
@@ -430,12 +432,31 @@ async function browserFeatures(ctx) {
   }
 }
 
-/** Sum of the proportional set sizes (PSS, MB) of all running Chromium processes. */
+/**
+ * Sum of the proportional set sizes (PSS, MB) of the Chromium processes this
+ * script started (descendants of this node process: a Chromium of someone
+ * else's tests on the same machine does not count).
+ */
 function chromiumPssMb() {
-  let kb = 0;
+  const parent = new Map();
+  const comm = new Map();
   for (const pid of fs.readdirSync('/proc').filter((d) => /^\d+$/.test(d))) {
     try {
-      if (!/chrom/.test(fs.readFileSync(`/proc/${pid}/comm`, 'utf8'))) continue;
+      // /proc/PID/stat: "pid (comm) state ppid ..."; comm may hold spaces.
+      const stat = fs.readFileSync(`/proc/${pid}/stat`, 'utf8');
+      const close = stat.lastIndexOf(')');
+      comm.set(pid, stat.slice(stat.indexOf('(') + 1, close));
+      parent.set(pid, stat.slice(close + 2).split(' ')[1]);
+    } catch { /* the process ended */ }
+  }
+  const ours = (pid) => {
+    for (let p = parent.get(pid); p && p !== '0'; p = parent.get(p)) if (p === String(process.pid)) return true;
+    return false;
+  };
+  let kb = 0;
+  for (const [pid, name] of comm) {
+    if (!/chrom/.test(name) || !ours(pid)) continue;
+    try {
       const m = /^Pss:\s+(\d+) kB/m.exec(fs.readFileSync(`/proc/${pid}/smaps_rollup`, 'utf8'));
       if (m) kb += Number(m[1]);
     } catch { /* the process ended */ }
@@ -444,30 +465,28 @@ function chromiumPssMb() {
 }
 
 /**
- * The whole method in the page's worker on the fandisk subdivided to 207 k
- * faces (sharp edges > 60° as features, α = 0.01): wall time from Run to the
- * result shown, the longest main-thread frame gap meanwhile, one plain redraw
- * of the solved view for scale (in headless Chromium both are mostly SwiftShader
- * rasterising the frame), and the peak memory of Chromium (PSS of all its
- * processes, sampled every 250 ms).
+ * The whole method in the page's worker, as a user runs it: a fresh page,
+ * `file` through the file input, `prepare(page)` (features, α; nothing: the
+ * defaults), Run, and the wait for the result shown. Measures the wall time
+ * from Run to the result shown, the longest main-thread frame gap meanwhile
+ * and the peak memory of Chromium (PSS of its processes, sampled every 250 ms
+ * over the load and the solve); reads the figures the results panel shows.
+ * `after(page)` runs on the solved page before it closes; what it returns is
+ * passed on as `after`.
  */
-async function browserSolveBig(ctx) {
+async function solveInPage(file, { prepare = async () => {}, after = async () => null } = {}) {
   const opened = await openBenchPage();
   if (opened.skipped) return opened;
   const { server, browser, page } = opened;
   let peak = chromiumPssMb();
   const sampler = setInterval(() => { peak = Math.max(peak, chromiumPssMb()); }, 250);
   try {
-    const mid = subObj(ctx.inputs[0].file, 2);
-    const input = path.basename(mid.file);
     const loads = await page.evaluate(() => window.__conemap.loads);
-    await page.getByTestId('file-input').setInputFiles(mid.file);
+    await page.getByTestId('file-input').setInputFiles(file);
     await page.waitForFunction((k) => window.__conemap.loads > k && window.__conemap.state !== 'loading', loads, { timeout: 300_000 });
-    await page.getByTestId('sharp-toggle').check();
-    await page.getByTestId('sharp-angle').fill('60');
-    await page.waitForFunction(() => window.__conemap.features > 0, null, { timeout: 120_000 });
-    // α slider is log10 α in [-3, 2].
-    await page.getByTestId('alpha').fill('-2');
+    const loaded = await page.evaluate(() => ({ state: window.__conemap.state, error: window.__conemap.lastError, faces: window.__conemap.stats?.faces }));
+    if (loaded.state !== 'ready') return { skipped: `page did not load ${path.basename(file)}: ${loaded.error}` };
+    await prepare(page);
     await page.evaluate(() => {
       const m = { maxGap: 0, running: true };
       window.__bench = m;
@@ -480,29 +499,92 @@ async function browserSolveBig(ctx) {
     await page.getByTestId('run').click();
     await page.waitForFunction((k) => window.__conemap.solves > k, solves, { timeout: 1_800_000, polling: 500 });
     const ms = Date.now() - t0;
-    const h = await page.evaluate(() => { window.__bench.running = false; return { result: window.__conemap.result, error: window.__conemap.solveError, gap: window.__bench.maxGap }; });
-    const note = h.result ? `${h.result.cones} cones, ${h.result.uv ? 'UVs' : 'no UVs'}, ${h.result.helperComponents} components placed by the helper worker` : `failed: ${h.error}`;
-    // For scale: one plain redraw of the solved 3D view (the Frame button), median of 3.
-    const redraws = [];
-    for (let i = 0; i < 3; i++) {
-      redraws.push(await page.evaluate(() => new Promise((resolve) => {
-        document.getElementById('frame-button').click();
-        const t = performance.now();
-        requestAnimationFrame(() => requestAnimationFrame(() => resolve(performance.now() - t)));
-      })));
-    }
-    const redraw = redraws.sort((a, b) => a - b)[1];
-    return [
-      { stage: 'Run → result shown (207 k faces, worker)', input, faces: mid.faces, ms, note },
-      { stage: 'longest frame gap during the solve', input, ms: h.gap, note: 'main thread stays responsive' },
-      { stage: 'one redraw of the solved 3D view', input, ms: redraw, note: 'Frame button, 2 frames; mostly SwiftShader rasterisation' },
-      { stage: 'peak Chromium memory (PSS, MB)', input, ms: NaN, note: `${peak.toFixed(0)} MB over the load and solve` },
-    ];
+    const h = await page.evaluate(() => {
+      window.__bench.running = false;
+      const c = window.__conemap;
+      const shown = (stat) => document.querySelector(`[data-testid=result-stats] dd[data-stat=${stat}]`)?.textContent ?? null;
+      return {
+        result: c.result, error: c.solveError, gap: window.__bench.maxGap, restarts: c.workerRestarts,
+        distortion: shown('distortion'), flipped: shown('flipped-faces'),
+      };
+    });
+    return { faces: loaded.faces, ms, ...h, after: await after(page), peak };
   } finally {
     clearInterval(sampler);
     await browser.close();
     await server.close();
   }
+}
+
+/** The note of a page solve: cones, distortion and flips as the results panel shows them, or why it failed. */
+const pageSolveNote = (s) => (s.result
+  ? `${s.result.cones} cones, distortion ${s.distortion ?? '—'}, ${s.flipped ?? '—'} flipped, ${s.result.uv ? 'UVs' : 'no UVs'}, `
+    + `${s.result.helperComponents} components placed by the helper worker`
+  : `failed: ${s.error}`) + (s.restarts ? `; worker restarted ${s.restarts}×` : '');
+
+/** The frame-gap and memory rows of a page solve. */
+const pageSolveRows = (input, s) => [
+  { stage: 'longest frame gap during the solve', input, ms: s.gap, note: 'includes drawing the solved view (SwiftShader in headless Chromium)' },
+  { stage: 'peak Chromium memory (PSS, MB)', input, ms: NaN, note: `${s.peak.toFixed(0)} MB over the load and solve` },
+];
+
+/**
+ * The fandisk subdivided to 207 k faces with its sharp edges (> 60°) as
+ * features, α = 0.01 (`solveInPage`), plus one plain redraw of the solved view
+ * for scale (in headless Chromium both it and the frame gap are mostly
+ * SwiftShader rasterising the frame).
+ */
+async function browserSolveBig(ctx) {
+  const mid = subObj(ctx.inputs[0].file, 2);
+  const input = path.basename(mid.file);
+  const s = await solveInPage(mid.file, {
+    async prepare(page) {
+      await page.getByTestId('sharp-toggle').check();
+      await page.getByTestId('sharp-angle').fill('60');
+      await page.waitForFunction(() => window.__conemap.features > 0, null, { timeout: 120_000 });
+      // α slider is log10 α in [-3, 2].
+      await page.getByTestId('alpha').fill('-2');
+    },
+    // For scale: one plain redraw of the solved 3D view (the Frame button), median of 3.
+    async after(page) {
+      const redraws = [];
+      for (let i = 0; i < 3; i++) {
+        redraws.push(await page.evaluate(() => new Promise((resolve) => {
+          document.getElementById('frame-button').click();
+          const t = performance.now();
+          requestAnimationFrame(() => requestAnimationFrame(() => resolve(performance.now() - t)));
+        })));
+      }
+      return redraws.sort((a, b) => a - b)[1];
+    },
+  });
+  if (s.skipped) return s;
+  const [gap, memory] = pageSolveRows(input, s);
+  return [
+    { stage: 'Run → result shown (207 k faces, worker)', input, faces: mid.faces, ms: s.ms, note: pageSolveNote(s) },
+    gap,
+    { stage: 'one redraw of the solved 3D view', input, ms: s.after, note: 'Frame button, 2 frames; mostly SwiftShader rasterisation' },
+    memory,
+  ];
+}
+
+/**
+ * Issue 13's page figures on single-component meshes, no features, the page's
+ * defaults (α slider, boundary fixed): spot subdivided twice (93 696 faces,
+ * target under 25 s) and the fandisk subdivided twice (207 136 faces, closed,
+ * one component; target under 60 s and 1.5 GB), each in a fresh page.
+ */
+async function browserSolveSingle(ctx) {
+  const spot = path.join(sharedMeshes, 'spot.obj');
+  if (!fs.existsSync(spot)) return { skipped: `${spot} not found` };
+  const rows = [];
+  for (const [mesh, target] of [[subObj(spot, 2), 'target < 25 s'], [subObj(ctx.inputs[0].file, 2), 'target < 60 s, 1.5 GB']]) {
+    const input = `${path.basename(mesh.file)} (no features)`;
+    const s = await solveInPage(mesh.file);
+    if (s.skipped) return s;
+    rows.push({ stage: 'Run → result shown (worker)', input, faces: s.faces, ms: s.ms, note: `${target}; ${pageSolveNote(s)}` }, ...pageSolveRows(input, s));
+  }
+  return rows;
 }
 
 async function browserLoad(ctx) {
@@ -591,6 +673,7 @@ const BENCHES = [
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },
   { env: 'browser', stage: 'solve-big', run: browserSolveBig, enabled: !args.has('--no-browser') && !quick },
+  { env: 'browser', stage: 'solve-single', run: browserSolveSingle, enabled: !args.has('--no-browser') && !quick },
 ];
 
 // ---------------------------------------------------------------- main
