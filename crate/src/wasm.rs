@@ -168,7 +168,7 @@ impl MeshSession {
     /// `progress(stage: string, step: number, remaining: number)` is called
     /// per topology step, rounding round and cone-move pass. Returns
     /// `{cones, boundary_corners, components, rounds, energy, phi_rms, timings,
-    /// inserted_vertices}` (cones on the mesh refined where the features need it).
+    /// feature_edges, free_boundary, inserted_vertices}` (cones on the mesh refined where the features need it).
     pub fn place_cones(
         &self,
         feature_edges: &[u32],
@@ -392,6 +392,7 @@ fn cone_result(r: &ConePlacement, feature_edges: usize) -> Result<Object, JsErro
     set(&out, "phi_rms", &r.phi_rms.into())?;
     set(&out, "timings", &to_js(&r.timings)?)?;
     set(&out, "feature_edges", &(feature_edges as f64).into())?;
+    set(&out, "free_boundary", &r.cut.has_free_boundary().into())?;
     Ok(out)
 }
 

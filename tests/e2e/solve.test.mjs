@@ -328,6 +328,22 @@ describe('feature editing and solving', () => {
     assert.equal(await error.isVisible(), false);
   });
 
+  it('leaves the boundary free with the toggle: woody (flat) gets no corners and no cones', async () => {
+    assert.ok((await sampleOptions()).includes('woody.obj'), 'woody.obj among the samples (../shared/meshes at build time)');
+    await loadSample('woody.obj');
+    const toggle = page.getByTestId('free-boundary');
+    await toggle.uncheck();
+    const aligned = (await runSolve()).result;
+    assert.ok(aligned.boundaryCorners > 0, 'aligned: corners');
+    await toggle.check();
+    const h = await runSolve();
+    assert.equal(h.state, 'solved', h.solveError ?? '');
+    assert.equal(h.result.boundaryCorners, 0);
+    assert.equal(h.result.cones, 0, 'a flat disk with a free boundary needs no cone');
+    assert.equal(h.result.uv, true);
+    await toggle.uncheck();
+  });
+
   it('logged no unexpected console errors', () => {
     assert.deepEqual(consoleErrors, []);
   });

@@ -606,7 +606,9 @@ export class Editor {
       ['Features', fmtInt(r.feature_edges)],
       ['Cones', coneText],
       ['Boundary corners', fmtInt(r.boundary_corners.length)],
-      ['Σk (cones + corners)', `${sumConeK + sumCornerK} = 4χ = ${4 * (report?.euler_characteristic ?? NaN)}`],
+      (r as { free_boundary?: boolean }).free_boundary
+        ? ['Σk (cones)', `${sumConeK} (free boundary: its curvature takes the rest of 4χ)`]
+        : ['Σk (cones + corners)', `${sumConeK + sumCornerK} = 4χ = ${4 * (report?.euler_characteristic ?? NaN)}`],
       ['Energy', fmt(r.energy, 4)],
       ['φ rms', fmt(r.phi_rms, 4)],
       ['Rounding rounds', fmtInt(r.rounds)],

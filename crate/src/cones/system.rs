@@ -26,10 +26,12 @@ use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::PI;
 
 mod curvature;
+mod free_curvature;
 mod indices;
 mod moves;
 
 use curvature::CurvatureSystem;
+use free_curvature::FreeCurvatureSystem;
 
 /// Weight of the harmonic norm in the lexicographic objective.
 const HARMONIC_WEIGHT: f64 = 1e4;
@@ -123,6 +125,8 @@ pub struct ComponentSystem<'a> {
     /// The curvature equation alone, for trials once every `p` is fixed
     /// (built on first use).
     curvature: Option<CurvatureSystem>,
+    /// Its counterpart on a component with a free boundary (built on first use).
+    free_curvature: Option<FreeCurvatureSystem>,
     /// How [`Self::round_all`] batches its fixes.
     pub rounding: RoundingRule,
 }
@@ -382,6 +386,7 @@ impl<'a> ComponentSystem<'a> {
             laplacian,
             path_rows,
             curvature: None,
+            free_curvature: None,
             rounding: RoundingRule::PerCluster,
         })
     }
@@ -425,6 +430,7 @@ impl<'a> ComponentSystem<'a> {
 
     /// Refactorizes when fixes are bordered, so that blocked solves with the
     /// factorization alone see every fix.
+    #[cfg(test)]
     fn refactor_if_bordered(&mut self) -> Result<(), ConeError> {
         if self.border.is_empty() {
             Ok(())
@@ -690,6 +696,15 @@ pub(crate) fn test_system(mesh: &TriMesh) -> ComponentSystem<'_> {
     let frames = Frames::new(mesh);
     let boundary_k = crate::features::boundary_turning(mesh);
     ComponentSystem::new(mesh, &frames, 0, &boundary_k, &[], Weights { alpha_smooth: 0.01, miq: false }).unwrap()
+}
+
+/// [`test_system`] with the whole boundary of `mesh` free.
+#[cfg(test)]
+pub(crate) fn test_system_free(mesh: &TriMesh) -> ComponentSystem<'_> {
+    let frames = Frames::new(mesh);
+    let boundary_k = crate::features::boundary_turning(mesh);
+    let free: Vec<bool> = (0..mesh.n_edges() as u32).map(|e| mesh.is_boundary_edge(e)).collect();
+    ComponentSystem::new(mesh, &frames, 0, &boundary_k, &free, Weights { alpha_smooth: 0.01, miq: false }).unwrap()
 }
 
 /// The `G` edges a cycle crosses, with the sign `+1` when the cycle crosses

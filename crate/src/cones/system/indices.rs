@@ -39,13 +39,36 @@ impl ComponentSystem<'_> {
     }
 
     /// [`Self::fix_indices`] on a component with a free boundary, where the
-    /// curvature equation does not hold `phi`: the `p` that the indices
-    /// determine are fixed, and the rest (the leftovers, and the tree path
-    /// from where a second free loop joins `T_p`) are rounded by Algorithm 1.
+    /// curvature equation does not hold `phi`. The indices leave free only
+    /// the integers that no vertex row holds: the leftovers and the parent
+    /// edges of free vertices where a second free loop joins `T_p` (the
+    /// holonomy around the homology loops and the holes), and the tree
+    /// paths above them. One solve with the rest fixed gives their relaxed
+    /// values; rounded, they determine the paths, and a second factorization
+    /// solves with every `p` fixed (Algorithm 1 rounds anything still free).
     fn fix_indices_free(&mut self, k: &[i64]) -> Result<(), ConeError> {
-        let mut p: Vec<Option<i64>> = self.fixed.clone();
+        let before = self.fixed.clone();
+        let mut p = before.clone();
         self.accumulate_along_tree(k, &mut p)?;
-        let before = std::mem::replace(&mut self.fixed, p);
+        self.fixed = p;
+        if let Err(e) = self.refactor_and_solve() {
+            self.fixed = before;
+            return Err(e);
+        }
+        let p0 = self.p0();
+        let leftovers = self.tree.leftovers.iter().map(|&e| self.tree.g_index[e as usize]);
+        let free_parents = (0..self.tree.vertices.len()).filter(|&i| self.cycles[i].free).filter_map(|i| {
+            let h = self.tree.primal_parent_he[self.tree.vertices[i] as usize];
+            (h != NONE).then(|| self.tree.g_index[self.mesh.edge(h) as usize])
+        });
+        let mut p = before.clone();
+        for g in leftovers.chain(free_parents).map(|g| g as usize) {
+            if self.fixed[g].is_none() && !self.continuous[g] {
+                p[g] = Some(self.x[p0 + g].round() as i64);
+            }
+        }
+        self.accumulate_along_tree(k, &mut p)?;
+        self.fixed = p;
         self.round_all(&mut |_, _| {}).inspect_err(|_| self.fixed = before)
     }
 
