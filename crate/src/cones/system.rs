@@ -431,9 +431,12 @@ impl<'a> ComponentSystem<'a> {
             self.residual = info.relative_residual;
             return Ok(());
         }
-        self.bordered_solve(&b)?;
+        // A border whose Schur complement is singular (a new fix that the
+        // held ones already determine) or that refines too little is left
+        // to a fresh, regularized factorization.
+        let bordered = self.bordered_solve(&b);
         let options = self.solver.options();
-        if self.residual > options.accept_residual.max(options.tolerance) {
+        if bordered.is_err() || self.residual > options.accept_residual.max(options.tolerance) {
             return self.refactor_and_solve();
         }
         Ok(())
