@@ -40,7 +40,9 @@ fn free_boundaries_are_seamless_and_cost_no_distortion() {
     // (mesh, largest free/aligned distortion ratio): a free boundary is a
     // relaxation, so no worse up to the greedy's noise on the torus's small
     // hole (16 edges), and clearly better on the face's long jagged one.
-    for (name, ratio) in [("bff-punctured-torus.obj", 1.02), ("bff-face.obj", 0.8)] {
+    // teapot: four open parts, tubes among them (its spout's reduced trial
+    // system defeats the unpivoted LDLᵀ: the component KKT answers there).
+    for (name, ratio) in [("bff-punctured-torus.obj", 1.02), ("bff-face.obj", 0.8), ("teapot.obj", 1.0)] {
         let input = mesh(name);
         let aligned = distortion(name, &input, BoundaryMode::Aligned);
         let free = distortion(name, &input, BoundaryMode::Free);

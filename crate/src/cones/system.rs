@@ -137,6 +137,8 @@ pub struct ComponentSystem<'a> {
     curvature: Option<CurvatureSystem>,
     /// Its counterpart on a component with a free boundary (built on first use).
     free_curvature: Option<FreeCurvatureSystem>,
+    /// Set once the free one failed a solve: trials then use the KKT.
+    free_curvature_failed: bool,
     /// How [`Self::round_all`] batches its fixes.
     pub rounding: RoundingRule,
 }
@@ -397,6 +399,7 @@ impl<'a> ComponentSystem<'a> {
             path_rows,
             curvature: None,
             free_curvature: None,
+            free_curvature_failed: false,
             rounding: RoundingRule::PerCluster,
         })
     }
@@ -440,7 +443,6 @@ impl<'a> ComponentSystem<'a> {
 
     /// Refactorizes when fixes are bordered, so that blocked solves with the
     /// factorization alone see every fix.
-    #[cfg(test)]
     fn refactor_if_bordered(&mut self) -> Result<(), ConeError> {
         if self.border.is_empty() {
             Ok(())

@@ -121,7 +121,15 @@ impl ComponentSystem<'_> {
             }
         }
         if self.has_free_boundary() {
-            return Ok(self.free_curvature()?.responses(&db, sets.len(), TRIAL_TOLERANCE)?);
+            if !self.free_curvature_failed {
+                match self.free_curvature().and_then(|f| Ok(f.responses(&db, sets.len(), TRIAL_TOLERANCE)?)) {
+                    Ok(dx) => return Ok(dx),
+                    // Its small proximal block can defeat the unpivoted LDLᵀ
+                    // (a teapot tube); the component's KKT then answers.
+                    Err(_) => self.free_curvature_failed = true,
+                }
+            }
+            return self.kkt_responses(sets);
         }
         Ok(self.curvature()?.responses(&db, sets.len(), TRIAL_TOLERANCE)?)
     }
@@ -148,15 +156,21 @@ impl ComponentSystem<'_> {
         let phi = self.x[..self.tree.vertices.len()].to_vec();
         // A ranking needs no more than the trials' accuracy.
         if self.has_free_boundary() {
-            return Ok(self.free_curvature()?.move_potential(&phi, TRIAL_TOLERANCE)?);
+            if !self.free_curvature_failed {
+                match self.free_curvature().and_then(|f| Ok(f.move_potential(&phi, TRIAL_TOLERANCE)?)) {
+                    Ok(potential) => return Ok(potential),
+                    Err(_) => self.free_curvature_failed = true,
+                }
+            }
+            return self.kkt_move_potential();
         }
         Ok(self.curvature()?.move_potential(&phi, TRIAL_TOLERANCE)?)
     }
 
-    /// [`Self::responses`] through the component's KKT (a check of the
-    /// reduced systems): a transfer changes fix rows' right-hand sides only,
-    /// so its response is `K⁻¹ Δb` with the factorization of the final integers.
-    #[cfg(test)]
+    /// [`Self::responses`] through the component's KKT (the check of the
+    /// reduced systems, and the fallback where the free one fails): a
+    /// transfer changes fix rows' right-hand sides only, so its response is
+    /// `K⁻¹ Δb` with the factorization of the final integers.
     fn kkt_responses(&mut self, sets: &[Vec<Transfer>]) -> Result<Vec<f64>, ConeError> {
         self.refactor_if_bordered()?;
         let (dim, width, fix0) = (self.kkt.pattern.dim(), self.response_width(), self.n + self.row_fix);
@@ -176,7 +190,6 @@ impl ComponentSystem<'_> {
     /// `y = K⁻¹ [M phi / A; 0]`, changing fixed `p_g` by `Δ` changes
     /// `phiᵀ M phi / A` by about `2 y_g Δ` (`y_g` at `p_g`'s fix row), and
     /// the potential accumulates these along `T_p` from its root.
-    #[cfg(test)]
     fn kkt_move_potential(&mut self) -> Result<Vec<f64>, ConeError> {
         self.refactor_if_bordered()?;
         let nv = self.tree.vertices.len();
