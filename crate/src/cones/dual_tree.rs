@@ -58,7 +58,7 @@ impl DualTree {
         let mut faces = Vec::new();
         let mut queue = VecDeque::new();
         let in_comp = |f: u32| mesh.face_components()[f as usize] == comp;
-        let is_free = |g: u32| free.get(mesh.edge(g) as usize).copied().unwrap_or(false);
+        let is_free = |g: u32| is_free_edge(free, mesh.edge(g));
 
         let loops: Vec<&Vec<u32>> = mesh
             .boundary_loops()
@@ -139,55 +139,39 @@ impl DualTree {
         let mut primal_parent_he = vec![NONE; nv];
         let mut primal_depth = vec![NONE; nv];
         let mut in_tp = vec![false; ne];
-        let free_start = comp_edges.iter().find(|&&e| free.get(e as usize).copied().unwrap_or(false));
-        if let Some(&e) = free_start {
-            // With a free boundary, T_p runs along the free edges wherever it
-            // can (fewest other edges from a free vertex: a 0-1 breadth-first
-            // search), so a free vertex's parent edge is a free port (no
-            // integer) except where a loop joins the rest.
-            let cost = |e: u32| if free.get(e as usize).copied().unwrap_or(false) { 0 } else { 1 };
-            let root_v = mesh.edge_vertices(e)[0];
-            let mut dist = vec![u32::MAX; nv];
-            let mut done = vec![false; nv];
-            dist[root_v as usize] = 0;
-            primal_depth[root_v as usize] = 0;
-            let mut vq = VecDeque::from([root_v]);
-            while let Some(v) = vq.pop_front() {
-                if std::mem::replace(&mut done[v as usize], true) {
-                    continue;
-                }
-                let ph = primal_parent_he[v as usize];
-                if ph != NONE {
-                    in_tp[mesh.edge(ph) as usize] = true;
-                    primal_depth[v as usize] = primal_depth[mesh.tail(ph) as usize] + 1;
-                }
-                for h in mesh.outgoing(v) {
-                    let e = mesh.edge(h);
-                    let w = mesh.head(h);
-                    let d = dist[v as usize] + cost(e);
-                    if !in_t[e as usize] && !done[w as usize] && d < dist[w as usize] {
-                        dist[w as usize] = d;
-                        primal_parent_he[w as usize] = h;
-                        if cost(e) == 0 {
-                            vq.push_front(w);
-                        } else {
-                            vq.push_back(w);
-                        }
-                    }
-                }
+        // Fewest non-free edges from the root (a 0-1 breadth-first search;
+        // without free edges a plain one): with a free boundary, T_p runs
+        // along the free edges wherever it can, so a free vertex's parent
+        // edge is a free port (no integer) except where a loop joins the rest.
+        let cost = |e: u32| u32::from(!is_free_edge(free, e));
+        let root_v = match comp_edges.iter().find(|&&e| is_free_edge(free, e)) {
+            Some(&e) => mesh.edge_vertices(e)[0],
+            None => vertices[0],
+        };
+        let mut dist = vec![u32::MAX; nv];
+        let mut done = vec![false; nv];
+        dist[root_v as usize] = 0;
+        primal_depth[root_v as usize] = 0;
+        let mut vq = VecDeque::from([root_v]);
+        while let Some(v) = vq.pop_front() {
+            if std::mem::replace(&mut done[v as usize], true) {
+                continue;
             }
-        } else {
-            let root_v = vertices[0];
-            primal_depth[root_v as usize] = 0;
-            let mut vq = VecDeque::from([root_v]);
-            while let Some(v) = vq.pop_front() {
-                for h in mesh.outgoing(v) {
-                    let e = mesh.edge(h);
-                    let w = mesh.head(h);
-                    if !in_t[e as usize] && primal_depth[w as usize] == NONE {
-                        primal_depth[w as usize] = primal_depth[v as usize] + 1;
-                        primal_parent_he[w as usize] = h;
-                        in_tp[e as usize] = true;
+            let ph = primal_parent_he[v as usize];
+            if ph != NONE {
+                in_tp[mesh.edge(ph) as usize] = true;
+                primal_depth[v as usize] = primal_depth[mesh.tail(ph) as usize] + 1;
+            }
+            for h in mesh.outgoing(v) {
+                let e = mesh.edge(h);
+                let w = mesh.head(h);
+                let d = dist[v as usize] + cost(e);
+                if !in_t[e as usize] && !done[w as usize] && d < dist[w as usize] {
+                    dist[w as usize] = d;
+                    primal_parent_he[w as usize] = h;
+                    if cost(e) == 0 {
+                        vq.push_front(w);
+                    } else {
                         vq.push_back(w);
                     }
                 }
@@ -321,6 +305,11 @@ impl DualTree {
         from_a.extend(from_b.into_iter().rev());
         from_a
     }
+}
+
+/// True when edge `e` is flagged in `free` (per mesh edge; an empty slice flags none).
+pub fn is_free_edge(free: &[bool], e: u32) -> bool {
+    free.get(e as usize).copied().unwrap_or(false)
 }
 
 /// `+1` when halfedge `h` runs along its edge's first halfedge, else `-1`.

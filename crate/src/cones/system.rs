@@ -16,7 +16,7 @@
 //! MIQ emulation: `alpha (phiᵀ L phi + hᵀ M_1 h) + phiᵀ M phi / A`.
 //! Only values change between rounds, so the symbolic analysis is done once.
 
-use super::dual_tree::DualTree;
+use super::dual_tree::{is_free_edge, DualTree};
 use super::frames::{vertex_cycle, Frames, Visit};
 use super::harmonic::HarmonicBasis;
 use super::RoundingRule;
@@ -215,7 +215,7 @@ impl<'a> ComponentSystem<'a> {
             .collect();
 
         let continuous: Vec<bool> =
-            tree.g_edges.iter().map(|&e| free.get(e as usize).copied().unwrap_or(false)).collect();
+            tree.g_edges.iter().map(|&e| is_free_edge(free, e)).collect();
         // Vertex cycles in the path basis.
         let cycles: Vec<VertexCycle> = tree
             .vertices

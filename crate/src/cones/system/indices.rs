@@ -67,7 +67,10 @@ impl ComponentSystem<'_> {
                 p[g] = Some(self.x[p0 + g].round() as i64);
             }
         }
-        self.accumulate_along_tree(k, &mut p)?;
+        if let Err(e) = self.accumulate_along_tree(k, &mut p) {
+            self.fixed = before;
+            return Err(e);
+        }
         self.fixed = p;
         self.round_all(&mut |_, _| {}).inspect_err(|_| self.fixed = before)
     }

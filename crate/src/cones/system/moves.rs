@@ -121,15 +121,7 @@ impl ComponentSystem<'_> {
             }
         }
         if self.has_free_boundary() {
-            if !self.free_curvature_failed {
-                match self.free_curvature().and_then(|f| Ok(f.responses(&db, sets.len(), TRIAL_TOLERANCE)?)) {
-                    Ok(dx) => return Ok(dx),
-                    // Its small proximal block can defeat the unpivoted LDLᵀ
-                    // (a teapot tube); the component's KKT then answers.
-                    Err(_) => self.free_curvature_failed = true,
-                }
-            }
-            return self.kkt_responses(sets);
+            return self.free_trial(|f| f.responses(&db, sets.len(), TRIAL_TOLERANCE), |s| s.kkt_responses(sets));
         }
         Ok(self.curvature()?.responses(&db, sets.len(), TRIAL_TOLERANCE)?)
     }
@@ -156,15 +148,26 @@ impl ComponentSystem<'_> {
         let phi = self.x[..self.tree.vertices.len()].to_vec();
         // A ranking needs no more than the trials' accuracy.
         if self.has_free_boundary() {
-            if !self.free_curvature_failed {
-                match self.free_curvature().and_then(|f| Ok(f.move_potential(&phi, TRIAL_TOLERANCE)?)) {
-                    Ok(potential) => return Ok(potential),
-                    Err(_) => self.free_curvature_failed = true,
-                }
-            }
-            return self.kkt_move_potential();
+            return self.free_trial(|f| f.move_potential(&phi, TRIAL_TOLERANCE), Self::kkt_move_potential);
         }
         Ok(self.curvature()?.move_potential(&phi, TRIAL_TOLERANCE)?)
+    }
+
+    /// A trial quantity on a free-boundary component: from the reduced
+    /// system, or from the component's KKT once the reduced one failed (its
+    /// small proximal block can defeat the unpivoted LDLᵀ: a teapot tube).
+    fn free_trial<T>(
+        &mut self,
+        reduced: impl FnOnce(&FreeCurvatureSystem) -> Result<T, crate::linalg::SolveError>,
+        kkt: impl FnOnce(&mut Self) -> Result<T, ConeError>,
+    ) -> Result<T, ConeError> {
+        if !self.free_curvature_failed {
+            match self.free_curvature().and_then(|f| Ok(reduced(f)?)) {
+                Ok(value) => return Ok(value),
+                Err(_) => self.free_curvature_failed = true,
+            }
+        }
+        kkt(self)
     }
 
     /// [`Self::responses`] through the component's KKT (the check of the
@@ -541,6 +544,7 @@ mod tests {
         let interior: Vec<usize> = (0..nv).filter(|&i| !mesh.is_boundary_vertex(sys.tree.vertices[i])).collect();
         let sets = vec![vec![(interior[1], interior[interior.len() - 2], 1)], vec![(interior[interior.len() / 2], interior[0], -2)]];
         let reduced = sys.responses(&sets).unwrap();
+        assert!(!sys.free_curvature_failed, "the reduced system answered (not the KKT fallback)");
         let kkt = sys.kkt_responses(&sets).unwrap();
         let scale = reduced.iter().fold(0.0f64, |m, d| m.max(d.abs()));
         assert!(scale > 1e-6);
@@ -551,6 +555,7 @@ mod tests {
             assert!((a - b).abs() < tolerance * scale, "free {}: entry {i}: reduced {a} vs KKT {b}", sys.has_free_boundary());
         }
         let (p1, p2) = (sys.move_potential().unwrap(), sys.kkt_move_potential().unwrap());
+        assert!(!sys.free_curvature_failed);
         // Potentials agree up to a constant (only differences are used).
         let (d1, d2) = (p1[interior[0]] - p1[interior[3]], p2[interior[0]] - p2[interior[3]]);
         let pscale = p1.iter().fold(0.0f64, |m, d| m.max(d.abs()));
