@@ -136,17 +136,28 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
 
     let mut interior = boundary.iter().filter(|b| !**b).count();
     let mut removed = 0usize;
+    // Scratch rings, reused across collapses (this loop is most of the cost).
+    let (mut ring_u, mut ring_v, mut ring_w) = (Vec::new(), Vec::new(), Vec::new());
+    // Stale candidates are dropped once they would make up most of the heap,
+    // so that it stays cache-sized (its pops were most of the decimation).
+    let mut compact_at = 2 * heap.len().max(1024);
     while interior > target_interior {
+        if heap.len() > compact_at {
+            heap.retain(|c| alive[c.from as usize] && alive[c.to as usize] && c.stamp == (stamp[c.from as usize], stamp[c.to as usize]));
+            compact_at = 2 * heap.len().max(1024);
+        }
         let Some(c) = heap.pop() else { break };
         let (u, v) = (c.from, c.to);
         if !alive[u as usize] || !alive[v as usize] || c.stamp != (stamp[u as usize], stamp[v as usize]) {
             continue;
         }
-        if !collapse_is_valid(pos, &faces, &incident, u, v) {
+        neighbours_into(&incident, &faces, u, &mut ring_u);
+        neighbours_into(&incident, &faces, v, &mut ring_v);
+        if !collapse_is_valid(pos, &faces, &incident, u, v, &ring_u, &ring_v) {
             continue;
         }
         // Collapse: drop the faces on edge uv, move u's other faces to v.
-        for f in incident[u as usize].clone() {
+        for f in std::mem::take(&mut incident[u as usize]) {
             let t = faces[f as usize];
             if t.contains(&v) {
                 alive_face[f as usize] = false;
@@ -158,17 +169,17 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
                 incident[v as usize].push(f);
             }
         }
-        incident[u as usize].clear();
         alive[u as usize] = false;
         let qu = quadric[u as usize];
         quadric[v as usize].add(&qu);
         interior -= 1;
         removed += 1;
         stamp[v as usize] += 1;
-        for w in neighbours(&incident, &faces, v) {
+        neighbours_into(&incident, &faces, v, &mut ring_v);
+        for &w in &ring_v {
             stamp[w as usize] += 1;
         }
-        for w in neighbours(&incident, &faces, v) {
+        for &w in &ring_v {
             for (a, b) in [(w, v), (v, w)] {
                 if !boundary[a as usize] {
                     heap.push(Candidate { cost: cost(&quadric, a, b), from: a, to: b, stamp: (stamp[a as usize], stamp[b as usize]) });
@@ -176,7 +187,8 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
             }
             // Edges of w to its other neighbours changed cost through w's stamp.
             if !boundary[w as usize] {
-                for x in neighbours(&incident, &faces, w) {
+                neighbours_into(&incident, &faces, w, &mut ring_w);
+                for &x in &ring_w {
                     if x != v {
                         heap.push(Candidate { cost: cost(&quadric, w, x), from: w, to: x, stamp: (stamp[w as usize], stamp[x as usize]) });
                     }
@@ -209,22 +221,31 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
 
 /// The vertices sharing a face with `v`, sorted.
 fn neighbours(incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32) -> Vec<u32> {
-    let mut out: Vec<u32> = incident[v as usize].iter().flat_map(|&f| faces[f as usize]).filter(|&w| w != v).collect();
+    let mut out = Vec::new();
+    neighbours_into(incident, faces, v, &mut out);
+    out
+}
+
+/// [`neighbours`] into `out` (cleared first).
+fn neighbours_into(incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32, out: &mut Vec<u32>) {
+    out.clear();
+    out.extend(incident[v as usize].iter().flat_map(|&f| faces[f as usize]).filter(|&w| w != v));
     out.sort_unstable();
     out.dedup();
-    out
 }
 
 /// The link condition (the common neighbours of `u` and `v` are the two
 /// vertices opposite edge uv) and the shape of the faces `u` moves to `v`.
+/// `nu`, `nvv`: the sorted [`neighbours`] of `u` and `v`.
 fn collapse_is_valid(
     pos: &[[f64; 3]],
     faces: &[[u32; 3]],
     incident: &[Vec<u32>],
     u: u32,
     v: u32,
+    nu: &[u32],
+    nvv: &[u32],
 ) -> bool {
-    let (nu, nvv) = (neighbours(incident, faces, u), neighbours(incident, faces, v));
     if !nvv.contains(&u) {
         return false;
     }
