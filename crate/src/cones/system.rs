@@ -111,7 +111,12 @@ pub struct ComponentSystem<'a> {
     row_fix: usize,
     constraint_rhs: Vec<f64>,
     kkt: Kkt,
-    solver: LdltSolver,
+    /// The KKT's LDLᵀ, built on the first factorization: a component placed
+    /// from coarse indices on an aligned boundary never needs it (every
+    /// integer is given, and the curvature equation gives `phi` and `h~`).
+    solver: Option<LdltSolver>,
+    /// Options of the KKT solver (kept while it is not built).
+    solver_options: SolverOptions,
     /// Slot of each fix row's coefficient `t_e` in the KKT values.
     fix_slots: Vec<usize>,
     /// Slot of each fix row's diagonal (`-1` while the row is inactive, so
@@ -368,8 +373,6 @@ impl<'a> ComponentSystem<'a> {
             .map(|g| kkt.pattern.slot(p0 + g, n + row_fix + g).expect("fix entry is in the pattern"))
             .collect();
         let fix_diag_slots = (0..ng).map(|g| kkt.pattern.diag_slot(n + row_fix + g)).collect();
-        let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs)?;
-        solver.set_options(SolverOptions { max_refinement_steps: 50, ..SolverOptions::default() });
         Ok(ComponentSystem {
             mesh,
             tree,
@@ -385,7 +388,8 @@ impl<'a> ComponentSystem<'a> {
             row_fix,
             constraint_rhs: rhs,
             kkt,
-            solver,
+            solver: None,
+            solver_options: SolverOptions { max_refinement_steps: 50, ..SolverOptions::default() },
             fix_slots,
             fix_diag_slots,
             border: FixBorder::default(),
@@ -413,7 +417,30 @@ impl<'a> ComponentSystem<'a> {
         self.tree.vertices.len() + self.basis.len()
     }
 
-    /// Refactors after fixes changed and solves.
+    /// The KKT solver, built (symbolic analysis) on first use.
+    fn kkt_solver(&mut self) -> Result<&mut LdltSolver, ConeError> {
+        if self.solver.is_none() {
+            self.solver = Some(LdltSolver::new(&self.kkt.pattern, &self.kkt.signs)?);
+        }
+        let solver = self.solver.as_mut().expect("built above");
+        solver.set_options(self.solver_options);
+        Ok(solver)
+    }
+
+    /// The KKT solver after a factorization ([`Self::refactor_and_solve`]).
+    fn factored(&self) -> &LdltSolver {
+        self.solver.as_ref().expect("the KKT is factorized before it solves")
+    }
+
+    /// Sets the KKT solver's options (now, or when it is built).
+    fn set_solver_options(&mut self, options: SolverOptions) {
+        self.solver_options = options;
+        if let Some(solver) = &mut self.solver {
+            solver.set_options(options);
+        }
+    }
+
+    /// Refactors the KKT after fixes changed and solves it.
     fn refactor_and_solve(&mut self) -> Result<(), ConeError> {
         for g in 0..self.fixed.len() {
             self.write_fix_row(g);
@@ -423,13 +450,16 @@ impl<'a> ComponentSystem<'a> {
         // iterative refinement against the exact matrix restores accuracy.
         loop {
             self.border.clear();
-            let result = self.solver.factorize(&self.kkt.values).map_err(ConeError::from).and_then(|()| self.solve());
-            let options = self.solver.options();
+            let values = std::mem::take(&mut self.kkt.values);
+            let factorized = self.kkt_solver().and_then(|solver| Ok(solver.factorize(&values)?));
+            self.kkt.values = values;
+            let result = factorized.and_then(|()| self.solve_kkt());
+            let options = self.solver_options;
             match result {
                 Err(ConeError::Solve(
                     SolveError::ZeroPivot { .. } | SolveError::NotFinite { .. } | SolveError::NotConverged { .. },
                 )) if options.delta < MAX_DELTA => {
-                    self.solver.set_options(SolverOptions { delta: options.delta * 100.0, ..options });
+                    self.set_solver_options(SolverOptions { delta: options.delta * 100.0, ..options });
                 }
                 Ok(()) => {
                     // Rounds until the next factorization change only held fix rows.
@@ -441,10 +471,10 @@ impl<'a> ComponentSystem<'a> {
         }
     }
 
-    /// Refactorizes when fixes are bordered, so that blocked solves with the
-    /// factorization alone see every fix.
+    /// Refactorizes when the KKT is not factorized or fixes are bordered, so
+    /// that blocked solves with the factorization alone see every fix.
     fn refactor_if_bordered(&mut self) -> Result<(), ConeError> {
-        if self.border.is_empty() {
+        if self.solver.is_some() && self.border.is_empty() {
             Ok(())
         } else {
             self.refactor_and_solve()
@@ -458,12 +488,68 @@ impl<'a> ComponentSystem<'a> {
         b
     }
 
-    /// Solves with the current factorization (and the bordered fixes made
-    /// since) and right-hand side, refining against the exact matrix.
+    /// True when every `p` is fixed and none is continuous (aligned
+    /// boundary): the curvature equation alone then holds `phi` and `h~`.
+    fn integers_fixed(&self) -> bool {
+        !self.has_free_boundary() && self.fixed.iter().all(Option::is_some)
+    }
+
+    /// Solves for `x` with the current fixes: by the curvature equation once
+    /// every integer is fixed ([`Self::solve_fixed`]), else by the KKT.
     pub(crate) fn solve(&mut self) -> Result<(), ConeError> {
+        if self.integers_fixed() {
+            self.solve_fixed()
+        } else {
+            self.solve_kkt()
+        }
+    }
+
+    /// `x` with every integer fixed, from the curvature equation: `phi` of
+    /// zero `M`-mean with `L phi = (pi/2) sum sigma p - transport` (the
+    /// vertex rows of eq. 16), `h~` from the path rows, `p` the fixes; the
+    /// multipliers are left 0. The KKT's solution has the same `phi` and
+    /// `h~` (the objective only picks `phi`'s constant). `residual` is then
+    /// that of the constraint rows.
+    fn solve_fixed(&mut self) -> Result<(), ConeError> {
+        let (nv, nh, p0) = (self.tree.vertices.len(), self.basis.len(), self.p0());
+        let b: Vec<f64> = (0..nv).map(|i| FRAC_PI_2 * (self.vertex_k_at(i) - 4 * self.cycles[i].j) as f64 - self.cycles[i].transport).collect();
+        let row_path = nv.saturating_sub(1);
+        let shift: Vec<f64> = (0..nh)
+            .map(|l| {
+                let g = self.tree.g_index[self.tree.leftovers[l] as usize] as usize;
+                self.constraint_rhs[row_path + l] + FRAC_PI_2 * self.fixed[g].expect("every p is fixed") as f64
+            })
+            .collect();
+        let curvature = self.curvature()?;
+        let phi = curvature.responses(&b, 1, 1e-12)?[..nv].to_vec();
+        let h = curvature.harmonic(&phi, &shift)?;
+        let dim = self.kkt.pattern.dim();
+        let mut x = vec![0.0; dim];
+        x[..nv].copy_from_slice(&phi);
+        x[nv..nv + nh].copy_from_slice(&h);
+        for (g, f) in self.fixed.iter().enumerate() {
+            x[p0 + g] = f.expect("every p is fixed") as f64;
+        }
+        let rhs = self.rhs();
+        let mut kx = vec![0.0; dim];
+        self.kkt.pattern.mul_vec(&self.kkt.values, &x, &mut kx)?;
+        let r2: f64 = (self.n..dim).map(|i| (rhs[i] - kx[i]).powi(2)).sum();
+        let b2: f64 = rhs[self.n..].iter().map(|v| v * v).sum();
+        self.residual = (r2 / b2.max(f64::MIN_POSITIVE)).sqrt();
+        self.x = x;
+        Ok(())
+    }
+
+    /// Solves the KKT with the current factorization (and the bordered
+    /// fixes made since) and right-hand side, refining against the exact
+    /// matrix; factorizes first if it never was.
+    pub(crate) fn solve_kkt(&mut self) -> Result<(), ConeError> {
+        if self.solver.is_none() {
+            return self.refactor_and_solve();
+        }
         let b = self.rhs();
         if self.border.is_empty() {
-            let (x, info) = self.solver.solve_with_info(&b)?;
+            let (x, info) = self.factored().solve_with_info(&b)?;
             self.refinement_steps += info.refinement_steps;
             self.x = x;
             self.residual = info.relative_residual;
@@ -473,7 +559,7 @@ impl<'a> ComponentSystem<'a> {
         // held ones already determine) or that refines too little is left
         // to a fresh, regularized factorization.
         let bordered = self.bordered_solve(&b);
-        let options = self.solver.options();
+        let options = self.solver_options;
         if bordered.is_err() || self.residual > options.accept_residual.max(options.tolerance) {
             return self.refactor_and_solve();
         }
@@ -483,9 +569,9 @@ impl<'a> ComponentSystem<'a> {
     /// [`Self::solve`] with bordered fixes: iterative refinement of the
     /// bordered solve against the exact matrix, up to the solver options' limits.
     fn bordered_solve(&mut self, b: &[f64]) -> Result<(), ConeError> {
-        let options = self.solver.options();
+        let options = self.solver_options;
         let bnorm = b.iter().map(|v| v * v).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
-        let mut x = self.border.solve(&self.solver, b)?;
+        let mut x = self.border.solve(self.factored(), b)?;
         let mut kx = vec![0.0; b.len()];
         for step in 0..=options.max_refinement_steps {
             self.kkt.pattern.mul_vec(&self.kkt.values, &x, &mut kx)?;
@@ -494,7 +580,7 @@ impl<'a> ComponentSystem<'a> {
             if self.residual < options.tolerance || step == options.max_refinement_steps {
                 break;
             }
-            let dx = self.border.solve(&self.solver, &r)?;
+            let dx = self.border.solve(self.factored(), &r)?;
             x.iter_mut().zip(&dx).for_each(|(xi, di)| *xi += di);
             self.refinement_steps += 1;
         }
@@ -523,8 +609,9 @@ impl<'a> ComponentSystem<'a> {
         }
         let (p0, fix0) = (self.p0(), self.n + self.row_fix);
         let fixes: Vec<(usize, usize)> = newly.iter().map(|&g| (p0 + g, fix0 + g)).collect();
-        self.border.push(&self.solver, &fixes)?;
-        self.solve()
+        let solver = self.solver.as_ref().expect("rounds start with a factorization");
+        self.border.push(solver, &fixes)?;
+        self.solve_kkt()
     }
 
     /// Algorithm 1: solve, fix in every free cluster the `p` nearest to
@@ -534,15 +621,16 @@ impl<'a> ComponentSystem<'a> {
     pub fn round_all(&mut self, progress: &mut dyn FnMut(usize, usize)) -> Result<(), ConeError> {
         // Rounding decisions need far less than the final accuracy: solve
         // intermediate rounds to ROUNDING_TOLERANCE, the last one exactly.
-        let exact = self.solver.options();
-        self.solver.set_options(SolverOptions { tolerance: ROUNDING_TOLERANCE.max(exact.tolerance), ..exact });
+        let exact = self.solver_options;
+        self.set_solver_options(SolverOptions { tolerance: ROUNDING_TOLERANCE.max(exact.tolerance), ..exact });
         let rounded = self.round_loop(progress);
-        let options = self.solver.options();
-        self.solver.set_options(SolverOptions { tolerance: exact.tolerance, ..options });
+        let options = self.solver_options;
+        self.set_solver_options(SolverOptions { tolerance: exact.tolerance, ..options });
         rounded?;
-        // Later stages change only right-hand sides: start them from a
-        // factorization of the final matrix.
-        if self.border.is_empty() {
+        // Later stages change only right-hand sides: with every integer
+        // fixed, the curvature equation; else (free ports) a factorization
+        // of the final matrix.
+        if self.integers_fixed() || self.border.is_empty() {
             self.solve()
         } else {
             self.refactor_and_solve()

@@ -16,8 +16,8 @@ use std::f64::consts::FRAC_PI_2;
 
 impl ComponentSystem<'_> {
     /// Fixes every `p` so that local vertex `i` gets index `k[i]` (boundary
-    /// vertices must carry their turning integers), then factorizes and
-    /// solves. Errs with [`ConeError::InconsistentBoundary`] when `k`
+    /// vertices must carry their turning integers), then solves the curvature
+    /// equation ([`ComponentSystem::solve_fixed`]; no KKT factorization). Errs with [`ConeError::InconsistentBoundary`] when `k`
     /// contradicts the boundary fixes or does not sum to `4 chi`.
     pub fn fix_indices(&mut self, k: &[i64]) -> Result<(), ConeError> {
         if self.has_free_boundary() {
@@ -35,7 +35,7 @@ impl ComponentSystem<'_> {
         self.accumulate_along_tree(k, &mut p)?;
         let before = std::mem::replace(&mut self.fixed, p);
         // On failure the system is left as it was, so the caller can round instead.
-        self.refactor_and_solve().inspect_err(|_| self.fixed = before)
+        self.solve_fixed().inspect_err(|_| self.fixed = before)
     }
 
     /// [`Self::fix_indices`] on a component with a free boundary, where the
@@ -194,6 +194,29 @@ mod tests {
         assert_eq!(given.vertex_k(), k);
         assert!(given.residual < 1e-9, "residual {}", given.residual);
         assert!(given.objective() <= rounded.objective() * (1.0 + 1e-9), "{} vs {}", given.objective(), rounded.objective());
+    }
+
+    /// With every integer fixed, the curvature equation's `phi` and `h~`
+    /// are the KKT's (torus: two homology loops; annulus: an alignment path).
+    fn fixed_solve_matches_the_kkt(mesh: &TriMesh) {
+        let mut sys = test_system(mesh);
+        sys.round_all(&mut |_, _| {}).unwrap();
+        sys.solve_kkt().unwrap();
+        let kkt = sys.x.clone();
+        sys.solve_fixed().unwrap();
+        let width = sys.tree.vertices.len() + sys.basis.len();
+        let scale = kkt[..width].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 1e-6);
+        for i in 0..width {
+            assert!((sys.x[i] - kkt[i]).abs() < 1e-9 * scale, "unknown {i}: {} vs KKT {}", sys.x[i], kkt[i]);
+        }
+        assert!(sys.residual < 1e-12, "constraint residual {}", sys.residual);
+    }
+
+    #[test]
+    fn fixed_solves_match_the_kkt() {
+        fixed_solve_matches_the_kkt(&torus(16, 8, 2.0, 0.7));
+        fixed_solve_matches_the_kkt(&square_annulus(6, 4, 0.4, 30f64.to_radians()));
     }
 
     #[test]

@@ -185,7 +185,7 @@ impl ComponentSystem<'_> {
                 }
             }
         }
-        let (x, _) = self.solver.solve_many_to(&rhs, sets.len(), TRIAL_TOLERANCE)?;
+        let (x, _) = self.factored().solve_many_to(&rhs, sets.len(), TRIAL_TOLERANCE)?;
         Ok(x.chunks(dim).flat_map(|c| c[..width].iter().copied()).collect())
     }
 
@@ -201,7 +201,7 @@ impl ComponentSystem<'_> {
         for i in 0..nv {
             rhs[i] = self.x[i] * self.area[i] / self.total_area;
         }
-        let (y, _) = self.solver.solve_many_to(&rhs, 1, TRIAL_TOLERANCE)?;
+        let (y, _) = self.factored().solve_many_to(&rhs, 1, TRIAL_TOLERANCE)?;
         let fix0 = self.n + self.row_fix;
         let mut order: Vec<usize> = (0..nv).collect();
         order.sort_by_key(|&i| self.tree.primal_depth[self.tree.vertices[i] as usize]);
@@ -516,7 +516,7 @@ mod tests {
         let dx = sys.responses(&[vec![transfer]]).unwrap();
         let before = sys.x.clone();
         sys.transfer(transfer);
-        sys.solve().unwrap();
+        sys.solve_kkt().unwrap();
         let width = sys.response_width();
         let scale = dx.iter().fold(0.0f64, |m, d| m.max(d.abs()));
         assert!(scale > 1e-6, "the transfer changes phi");
