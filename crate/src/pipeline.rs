@@ -510,14 +510,23 @@ impl Placed {
                 _ => break,
             }
         }
-        // A map that folds is not a result (issue 13). Per-cluster rounding
+        // A map that folds is not a result (issue 13). Fallbacks, each placing
+        // again from the input: where the placement came from coarse levels,
+        // place on the component itself (cow x4 at 20-40°: the coarse
+        // placements of its 1 700 feature edges folded); per-cluster rounding
         // decides in parallel what the paper's rule decides one batch at a
-        // time; where that placement folds, place once more the paper's way.
+        // time, so where that placement folds, place once more the paper's
+        // way. (The retry's own fallback then covers the last.)
         let m = &best.param.metrics;
-        if (m.flipped > 0 || m.wound_vertices > 0) && options.cones.rounding == RoundingRule::PerCluster {
-            let mut whole = options;
-            whole.cones.rounding = RoundingRule::Whole;
-            let stage = ConeStage::with_refinement(mesh, features, &whole, initial, 0, refine_seconds, now_seconds());
+        let coarse = options.cones.coarse_vertices < usize::MAX && mesh.n_vertices() > options.cones.coarse_vertices;
+        if (m.flipped > 0 || m.wound_vertices > 0) && (coarse || options.cones.rounding == RoundingRule::PerCluster) {
+            let mut retry = options;
+            if coarse {
+                retry.cones.coarse_vertices = usize::MAX;
+            } else {
+                retry.cones.rounding = RoundingRule::Whole;
+            }
+            let stage = ConeStage::with_refinement(mesh, features, &retry, initial, 0, refine_seconds, now_seconds());
             let attempt = stage
                 .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
                 .and_then(|placed| placed.parametrize(mesh, features, progress));

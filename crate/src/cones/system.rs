@@ -511,6 +511,11 @@ impl<'a> ComponentSystem<'a> {
     /// `h~` (the objective only picks `phi`'s constant). `residual` is then
     /// that of the constraint rows.
     fn solve_fixed(&mut self) -> Result<(), ConeError> {
+        // The fix rows as active (what a factorization made since the last
+        // fixes, with its border, already holds).
+        for g in 0..self.fixed.len() {
+            self.write_fix_row(g);
+        }
         let (nv, nh, p0) = (self.tree.vertices.len(), self.basis.len(), self.p0());
         let b: Vec<f64> = (0..nv).map(|i| FRAC_PI_2 * (self.vertex_k_at(i) - 4 * self.cycles[i].j) as f64 - self.cycles[i].transport).collect();
         let row_path = nv.saturating_sub(1);

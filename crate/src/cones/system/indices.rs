@@ -34,6 +34,10 @@ impl ComponentSystem<'_> {
         }
         self.accumulate_along_tree(k, &mut p)?;
         let before = std::mem::replace(&mut self.fixed, p);
+        // A factorization of earlier fixes no longer fits (the KKT is
+        // factorized again where trials need it).
+        self.solver = None;
+        self.border.clear();
         // On failure the system is left as it was, so the caller can round instead.
         self.solve_fixed().inspect_err(|_| self.fixed = before)
     }
