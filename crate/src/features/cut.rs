@@ -161,10 +161,7 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
             if order.is_empty() {
                 break;
             }
-            order.sort_by(|a, b| {
-                let close = (a.0 - b.0).abs() < 1e-9;
-                (if close { std::cmp::Ordering::Equal } else { b.0.total_cmp(&a.0) }).then(a.1.cmp(&b.1))
-            });
+            order.sort_by(closest_first);
             let moved = need.min(order.len());
             for &(_, _, v) in &order[..moved] {
                 k[v as usize] += step;
@@ -173,6 +170,15 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
         }
     }
     k
+}
+
+/// Order of corners `(closeness, tie hash, vertex)` for [`boundary_turning`]:
+/// closest to going the other way first, closeness in buckets of 1e-9 and
+/// ties by hash. (A tolerance comparison is not a total order, and the sort
+/// panicked on it: a jittered bff-face x4.)
+fn closest_first(a: &(f64, u64, u32), b: &(f64, u64, u32)) -> std::cmp::Ordering {
+    let bucket = |x: f64| (x * 1e9).round();
+    bucket(b.0).total_cmp(&bucket(a.0)).then(a.1.cmp(&b.1))
 }
 
 /// Difference (quarter turns) between what a component's interior must
@@ -186,4 +192,31 @@ fn spread(v: u32) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::closest_first;
+    use std::cmp::Ordering;
+
+    /// Corners whose closeness differs by less than the old 1e-9 tolerance in
+    /// a chain (a ~ b, b ~ c, a !~ c) are still ordered consistently:
+    /// transitive, antisymmetric, and a sort of them does not panic.
+    #[test]
+    fn corner_order_is_a_total_order() {
+        let values: Vec<(f64, u64, u32)> = (0..200u32).map(|i| (0.3 + i as f64 * 0.6e-9, (i as u64 * 7919) % 97, i)).collect();
+        for a in &values {
+            for b in &values {
+                assert_eq!(closest_first(a, b), closest_first(b, a).reverse());
+                for c in values.iter().step_by(7) {
+                    if closest_first(a, b) != Ordering::Greater && closest_first(b, c) != Ordering::Greater {
+                        assert_ne!(closest_first(a, c), Ordering::Greater, "{a:?} {b:?} {c:?}");
+                    }
+                }
+            }
+        }
+        let mut sorted = values.clone();
+        sorted.sort_by(closest_first);
+        assert!(sorted.windows(2).all(|w| closest_first(&w[0], &w[1]) != Ordering::Greater));
+    }
 }
