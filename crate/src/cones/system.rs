@@ -540,7 +540,14 @@ impl<'a> ComponentSystem<'a> {
         self.kkt.pattern.mul_vec(&self.kkt.values, &x, &mut kx)?;
         let r2: f64 = (self.n..dim).map(|i| (rhs[i] - kx[i]).powi(2)).sum();
         let b2: f64 = rhs[self.n..].iter().map(|v| v * v).sum();
-        self.residual = (r2 / b2.max(f64::MIN_POSITIVE)).sqrt();
+        let residual = (r2 / b2.max(f64::MIN_POSITIVE)).sqrt();
+        // Integers the rows cannot all meet (e.g. a pin row the given
+        // indices contradict) are an error, as the KKT's solve would be.
+        let accept = self.solver_options.accept_residual.max(self.solver_options.tolerance);
+        if residual.is_nan() || residual > accept {
+            return Err(SolveError::NotConverged { relative_residual: residual, steps: 0 }.into());
+        }
+        self.residual = residual;
         self.x = x;
         Ok(())
     }
