@@ -518,7 +518,7 @@ impl Placed {
         // time, so where that placement folds, place once more the paper's
         // way. (The retry's own fallback then covers the last.)
         let m = &best.param.metrics;
-        let coarse = options.cones.coarse_vertices < usize::MAX && mesh.n_vertices() > options.cones.coarse_vertices;
+        let coarse = mesh.n_vertices() > options.cones.coarse_vertices;
         if (m.flipped > 0 || m.wound_vertices > 0) && (coarse || options.cones.rounding == RoundingRule::PerCluster) {
             let mut retry = options;
             if coarse {

@@ -417,19 +417,24 @@ impl<'a> ComponentSystem<'a> {
         self.tree.vertices.len() + self.basis.len()
     }
 
-    /// The KKT solver, built (symbolic analysis) on first use.
-    fn kkt_solver(&mut self) -> Result<&mut LdltSolver, ConeError> {
+    /// Builds the KKT solver (its symbolic analysis) on first use.
+    fn build_kkt_solver(&mut self) -> Result<(), ConeError> {
         if self.solver.is_none() {
-            self.solver = Some(LdltSolver::new(&self.kkt.pattern, &self.kkt.signs)?);
+            let mut solver = LdltSolver::new(&self.kkt.pattern, &self.kkt.signs)?;
+            solver.set_options(self.solver_options);
+            self.solver = Some(solver);
         }
-        let solver = self.solver.as_mut().expect("built above");
-        solver.set_options(self.solver_options);
-        Ok(solver)
+        Ok(())
     }
 
     /// The KKT solver after a factorization ([`Self::refactor_and_solve`]).
     fn factored(&self) -> &LdltSolver {
         self.solver.as_ref().expect("the KKT is factorized before it solves")
+    }
+
+    /// Relative residual above which a solve is a failure.
+    fn accept_residual(&self) -> f64 {
+        self.solver_options.accept_residual.max(self.solver_options.tolerance)
     }
 
     /// Sets the KKT solver's options (now, or when it is built).
@@ -450,10 +455,9 @@ impl<'a> ComponentSystem<'a> {
         // iterative refinement against the exact matrix restores accuracy.
         loop {
             self.border.clear();
-            let values = std::mem::take(&mut self.kkt.values);
-            let factorized = self.kkt_solver().and_then(|solver| Ok(solver.factorize(&values)?));
-            self.kkt.values = values;
-            let result = factorized.and_then(|()| self.solve_kkt());
+            self.build_kkt_solver()?;
+            let solver = self.solver.as_mut().expect("built above");
+            let result = solver.factorize(&self.kkt.values).map_err(ConeError::from).and_then(|()| self.solve_kkt());
             let options = self.solver_options;
             match result {
                 Err(ConeError::Solve(
@@ -473,7 +477,7 @@ impl<'a> ComponentSystem<'a> {
 
     /// Refactorizes when the KKT is not factorized or fixes are bordered, so
     /// that blocked solves with the factorization alone see every fix.
-    fn refactor_if_bordered(&mut self) -> Result<(), ConeError> {
+    fn factorize_if_stale(&mut self) -> Result<(), ConeError> {
         if self.solver.is_some() && self.border.is_empty() {
             Ok(())
         } else {
@@ -504,6 +508,12 @@ impl<'a> ComponentSystem<'a> {
         }
     }
 
+    /// The curvature equation's right-hand side for vertex indices `k`:
+    /// `b_i = (pi/2)(k_i - 4 j_i) - transport_i` (see [`curvature`]).
+    fn curvature_rhs(&self, k: &[i64]) -> Vec<f64> {
+        k.iter().zip(&self.cycles).map(|(&ki, c)| FRAC_PI_2 * (ki - 4 * c.j) as f64 - c.transport).collect()
+    }
+
     /// `x` with every integer fixed, from the curvature equation: `phi` of
     /// zero `M`-mean with `L phi = (pi/2) sum sigma p - transport` (the
     /// vertex rows of eq. 16), `h~` from the path rows, `p` the fixes; the
@@ -517,7 +527,7 @@ impl<'a> ComponentSystem<'a> {
             self.write_fix_row(g);
         }
         let (nv, nh, p0) = (self.tree.vertices.len(), self.basis.len(), self.p0());
-        let b: Vec<f64> = (0..nv).map(|i| FRAC_PI_2 * (self.vertex_k_at(i) - 4 * self.cycles[i].j) as f64 - self.cycles[i].transport).collect();
+        let b = self.curvature_rhs(&self.vertex_k());
         let row_path = nv.saturating_sub(1);
         let shift: Vec<f64> = (0..nh)
             .map(|l| {
@@ -543,8 +553,7 @@ impl<'a> ComponentSystem<'a> {
         let residual = (r2 / b2.max(f64::MIN_POSITIVE)).sqrt();
         // Integers the rows cannot all meet (e.g. a pin row the given
         // indices contradict) are an error, as the KKT's solve would be.
-        let accept = self.solver_options.accept_residual.max(self.solver_options.tolerance);
-        if residual.is_nan() || residual > accept {
+        if residual.is_nan() || residual > self.accept_residual() {
             return Err(SolveError::NotConverged { relative_residual: residual, steps: 0 }.into());
         }
         self.residual = residual;
@@ -571,8 +580,7 @@ impl<'a> ComponentSystem<'a> {
         // held ones already determine) or that refines too little is left
         // to a fresh, regularized factorization.
         let bordered = self.bordered_solve(&b);
-        let options = self.solver_options;
-        if bordered.is_err() || self.residual > options.accept_residual.max(options.tolerance) {
+        if bordered.is_err() || self.residual > self.accept_residual() {
             return self.refactor_and_solve();
         }
         Ok(())

@@ -126,9 +126,12 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
         q.error(pos[v as usize]) + 1e-3 * { let d = vec3::sub(pos[u as usize], pos[v as usize]); vec3::dot(d, d) }
     };
     let mut heap = BinaryHeap::new();
+    // Scratch rings, reused across collapses (this loop is most of the cost).
+    let (mut ring_u, mut ring_v, mut ring_w) = (Vec::new(), Vec::new(), Vec::new());
     for u in 0..nv as u32 {
         if !boundary[u as usize] {
-            for v in neighbours(&incident, &faces, u) {
+            neighbours_into(&incident, &faces, u, &mut ring_u);
+            for &v in &ring_u {
                 heap.push(Candidate { cost: cost(&quadric, u, v), from: u, to: v, stamp: (0, 0) });
             }
         }
@@ -136,8 +139,6 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
 
     let mut interior = boundary.iter().filter(|b| !**b).count();
     let mut removed = 0usize;
-    // Scratch rings, reused across collapses (this loop is most of the cost).
-    let (mut ring_u, mut ring_v, mut ring_w) = (Vec::new(), Vec::new(), Vec::new());
     // Stale candidates are dropped once they would make up most of the heap,
     // so that it stays cache-sized (its pops were most of the decimation).
     let mut compact_at = 2 * heap.len().max(1024);
@@ -219,14 +220,7 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
     (coarse.n_vertices() == vertex.len()).then_some(Decimated { mesh: coarse, vertex })
 }
 
-/// The vertices sharing a face with `v`, sorted.
-fn neighbours(incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32) -> Vec<u32> {
-    let mut out = Vec::new();
-    neighbours_into(incident, faces, v, &mut out);
-    out
-}
-
-/// [`neighbours`] into `out` (cleared first).
+/// The vertices sharing a face with `v`, sorted, into `out` (cleared first).
 fn neighbours_into(incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32, out: &mut Vec<u32>) {
     out.clear();
     out.extend(incident[v as usize].iter().flat_map(|&f| faces[f as usize]).filter(|&w| w != v));
@@ -236,7 +230,7 @@ fn neighbours_into(incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32, out: &mut 
 
 /// The link condition (the common neighbours of `u` and `v` are the two
 /// vertices opposite edge uv) and the shape of the faces `u` moves to `v`.
-/// `nu`, `nvv`: the sorted [`neighbours`] of `u` and `v`.
+/// `nu`, `nvv`: the sorted [`neighbours_into`] of `u` and `v`.
 fn collapse_is_valid(
     pos: &[[f64; 3]],
     faces: &[[u32; 3]],

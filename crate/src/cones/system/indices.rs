@@ -17,19 +17,20 @@ use std::f64::consts::FRAC_PI_2;
 impl ComponentSystem<'_> {
     /// Fixes every `p` so that local vertex `i` gets index `k[i]` (boundary
     /// vertices must carry their turning integers), then solves the curvature
-    /// equation ([`ComponentSystem::solve_fixed`]; no KKT factorization). Errs with [`ConeError::InconsistentBoundary`] when `k`
-    /// contradicts the boundary fixes or does not sum to `4 chi`.
+    /// equation ([`ComponentSystem::solve_fixed`]; no KKT factorization).
+    /// Errs with [`ConeError::InconsistentBoundary`] when `k` contradicts the
+    /// boundary fixes or does not sum to `4 chi`.
     pub fn fix_indices(&mut self, k: &[i64]) -> Result<(), ConeError> {
         if self.has_free_boundary() {
             return self.fix_indices_free(k);
         }
         let nv = self.tree.vertices.len();
         let nh = self.basis.len();
-        // phi from the curvature equation.
-        let b: Vec<f64> = (0..nv).map(|i| FRAC_PI_2 * (k[i] - 4 * self.cycles[i].j) as f64 - self.cycles[i].transport).collect();
-        let phi = self.curvature()?.responses(&b, 1, 1e-12)?[..nv].to_vec();
         let mut p: Vec<Option<i64>> = self.fixed.clone();
         if nh > 0 {
+            // The path integers see phi (from the curvature equation) only.
+            let b = self.curvature_rhs(k);
+            let phi = self.curvature()?.responses(&b, 1, 1e-12)?[..nv].to_vec();
             self.choose_path_integers(&phi, &mut p)?;
         }
         self.accumulate_along_tree(k, &mut p)?;

@@ -175,7 +175,7 @@ impl ComponentSystem<'_> {
     /// transfer changes fix rows' right-hand sides only, so its response is
     /// `K⁻¹ Δb` with the factorization of the final integers.
     fn kkt_responses(&mut self, sets: &[Vec<Transfer>]) -> Result<Vec<f64>, ConeError> {
-        self.refactor_if_bordered()?;
+        self.factorize_if_stale()?;
         let (dim, width, fix0) = (self.kkt.pattern.dim(), self.response_width(), self.n + self.row_fix);
         let mut rhs = vec![0.0; dim * sets.len()];
         for (col, set) in sets.iter().enumerate() {
@@ -194,7 +194,7 @@ impl ComponentSystem<'_> {
     /// `phiᵀ M phi / A` by about `2 y_g Δ` (`y_g` at `p_g`'s fix row), and
     /// the potential accumulates these along `T_p` from its root.
     fn kkt_move_potential(&mut self) -> Result<Vec<f64>, ConeError> {
-        self.refactor_if_bordered()?;
+        self.factorize_if_stale()?;
         let nv = self.tree.vertices.len();
         let dim = self.kkt.pattern.dim();
         let mut rhs = vec![0.0; dim];
