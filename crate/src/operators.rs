@@ -1,4 +1,4 @@
-//! Discrete differential operators on plain arrays (OWNER: linalg helper).
+//! Discrete differential operators on plain arrays.
 //!
 //! Inputs are `positions: &[[f64; 3]]` and `triangles: &[[u32; 3]]` (vertex
 //! indices, counter-clockwise = outward orientation), so these functions do
@@ -15,8 +15,6 @@
 //!   `π − Σθ` at boundary vertices (geodesic curvature).
 
 use std::f64::consts::PI;
-
-use sprs::{CsMat, TriMat};
 
 use crate::vec3::{cross, dot, norm, sub, V3};
 
@@ -115,18 +113,6 @@ pub fn cotan_laplacian_triplets(positions: &[[f64; 3]], triangles: &[[u32; 3]]) 
     t
 }
 
-/// The PSD cotangent Laplacian `L` (discretizes `−∇²`) as an `n × n` CSR
-/// matrix, `n = positions.len()`; `L·1 = 0`, symmetric.
-pub fn cotan_laplacian(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> CsMat<f64> {
-    let n = positions.len();
-    let trip = cotan_laplacian_triplets(positions, triangles);
-    let mut tm = TriMat::with_capacity((n, n), trip.len());
-    for (r, c, v) in trip {
-        tm.add_triplet(r, c, v);
-    }
-    tm.to_csr()
-}
-
 /// Barycentric lumped vertex areas (the diagonal of `M`): each vertex gets one
 /// third of the area of every incident triangle.  Chosen over mixed-Voronoi
 /// areas because it is always positive (obtuse triangles included), is the
@@ -168,90 +154,6 @@ pub fn angle_defects(positions: &[[f64; 3]], triangles: &[[u32; 3]], is_boundary
         .zip(is_boundary_vertex)
         .map(|(s, &b)| if b { PI - s } else { 2.0 * PI - s })
         .collect()
-}
-
-/// Flags the vertices on a boundary edge (an edge used by exactly one
-/// triangle).  For a manifold, consistently oriented mesh.
-pub fn boundary_vertex_flags(n_vertices: usize, triangles: &[[u32; 3]]) -> Vec<bool> {
-    let mut edges: Vec<(u32, u32)> = triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
-        .collect();
-    edges.sort_unstable();
-    let mut flags = vec![false; n_vertices];
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j] == edges[i] {
-            j += 1;
-        }
-        if j - i == 1 {
-            flags[edges[i].0 as usize] = true;
-            flags[edges[i].1 as usize] = true;
-        }
-        i = j;
-    }
-    flags
-}
-
-/// Signed dihedral (bending) angle for each interior edge, given as the pair
-/// of its two faces `edge_faces[e] = [f0, f1]`: the angle between the unit
-/// normals of `f0` and `f1`, in `(−π, π]`, positive where the surface is
-/// convex across the edge (as on a convex polyhedron with outward normals),
-/// negative where concave, 0 when flat.  Requires consistent orientation;
-/// `NaN` if the two faces do not share exactly one edge or one is degenerate.
-pub fn dihedral_angles(positions: &[[f64; 3]], triangles: &[[u32; 3]], edge_faces: &[[u32; 2]]) -> Vec<f64> {
-    let normals = face_normals(positions, triangles);
-    edge_faces
-        .iter()
-        .map(|&[f0, f1]| {
-            let (t0, t1) = (&triangles[f0 as usize], &triangles[f1 as usize]);
-            // The shared edge, oriented as in f0.
-            let shared = (0..3).find(|&k| {
-                let (a, b) = (t0[k], t0[(k + 1) % 3]);
-                t1.contains(&a) && t1.contains(&b) && !t1.contains(&t0[(k + 2) % 3])
-            });
-            let Some(k) = shared else { return f64::NAN };
-            let e = sub(positions[t0[(k + 1) % 3] as usize], positions[t0[k] as usize]);
-            let le = norm(e);
-            let (n0, n1) = (normals[f0 as usize], normals[f1 as usize]);
-            if le == 0.0 || dot(n0, n0) == 0.0 || dot(n1, n1) == 0.0 {
-                return f64::NAN;
-            }
-            let s = dot(cross(n0, n1), e) / le;
-            s.atan2(dot(n0, n1))
-        })
-        .collect()
-}
-
-/// Interior edges with their two faces: `(edge [v_lo, v_hi], [f0, f1])`,
-/// sorted by edge; edges with one face (boundary) or more than two
-/// (non-manifold) are skipped.  Input for [`dihedral_angles`].
-pub fn interior_edge_faces(triangles: &[[u32; 3]]) -> Vec<([u32; 2], [u32; 2])> {
-    let mut he: Vec<([u32; 2], u32)> = triangles
-        .iter()
-        .enumerate()
-        .flat_map(|(f, t)| {
-            (0..3).map(move |k| {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                ([a.min(b), a.max(b)], f as u32)
-            })
-        })
-        .collect();
-    he.sort_unstable();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < he.len() {
-        let mut j = i + 1;
-        while j < he.len() && he[j].0 == he[i].0 {
-            j += 1;
-        }
-        if j - i == 2 {
-            out.push((he[i].0, [he[i].1, he[i + 1].1]));
-        }
-        i = j;
-    }
-    out
 }
 
 #[cfg(test)]
@@ -328,24 +230,34 @@ mod tests {
         (p, t)
     }
 
-    fn matvec(l: &CsMat<f64>, x: &[f64]) -> Vec<f64> {
-        let mut y = vec![0.0; l.rows()];
-        for (v, (r, c)) in l.iter() {
+    /// `L x` from the triplets of [`cotan_laplacian_triplets`].
+    fn matvec(l: &[(usize, usize, f64)], x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; x.len()];
+        for &(r, c, v) in l {
             y[r] += v * x[c];
         }
         y
+    }
+
+    /// `L` as a dense matrix (rows), duplicates summed.
+    fn dense(l: &[(usize, usize, f64)], n: usize) -> Vec<Vec<f64>> {
+        let mut d = vec![vec![0.0; n]; n];
+        for &(r, c, v) in l {
+            d[r][c] += v;
+        }
+        d
     }
 
     #[test]
     fn flat_grid_laplacian_mass_and_defects() {
         let (p, t) = grid(6, 5, 0.5);
         let n = p.len();
-        let l = cotan_laplacian(&p, &t);
+        let l = cotan_laplacian_triplets(&p, &t);
         // L·1 = 0 everywhere.
         let ones = vec![1.0; n];
         assert!(matvec(&l, &ones).iter().all(|v| v.abs() < 1e-12));
         // L·(linear) = 0 at interior vertices.
-        let boundary = boundary_vertex_flags(n, &t);
+        let boundary: Vec<bool> = p.iter().map(|q| q[0] == 0.0 || q[1] == 0.0 || q[0] == 3.0 || q[1] == 2.5).collect();
         let lin: Vec<f64> = p.iter().map(|q| 2.0 * q[0] - 3.0 * q[1] + 0.7).collect();
         let y = matvec(&l, &lin);
         for v in 0..n {
@@ -354,11 +266,13 @@ mod tests {
             }
         }
         // PSD sign: diagonal positive, off-diagonal ≤ 0 on this (right-angled) grid.
-        for (v, (r, c)) in l.iter() {
-            if r == c {
-                assert!(*v > 0.0);
-            } else {
-                assert!(*v <= 1e-15);
+        for (r, row) in dense(&l, n).iter().enumerate() {
+            for (c, &v) in row.iter().enumerate() {
+                if r == c {
+                    assert!(v > 0.0);
+                } else {
+                    assert!(v <= 1e-15);
+                }
             }
         }
         // Σ M = area.
@@ -373,10 +287,6 @@ mod tests {
             let expect = if corners.contains(&v) { PI / 2.0 } else { 0.0 };
             assert!((d[v] - expect).abs() < 1e-12, "defect at {v} = {}", d[v]);
         }
-        // Flat: all interior dihedral angles vanish.
-        let ef: Vec<[u32; 2]> = interior_edge_faces(&t).into_iter().map(|(_, f)| f).collect();
-        assert_eq!(ef.len(), 3 * 6 * 5 - 6 - 5);
-        assert!(dihedral_angles(&p, &t, &ef).iter().all(|a| a.abs() < 1e-12));
     }
 
     #[test]
@@ -387,13 +297,13 @@ mod tests {
             q[2] = 0.3 * ((i * 7 % 5) as f64 - 2.0) / 2.0;
             q[0] += 0.1 * ((i * 3 % 4) as f64 - 1.5);
         }
-        let l = cotan_laplacian(&p, &t);
-        let dense = l.to_dense();
+        let l = cotan_laplacian_triplets(&p, &t);
+        let d = dense(&l, p.len());
         for i in 0..p.len() {
-            let row_sum: f64 = (0..p.len()).map(|j| dense[[i, j]]).sum();
+            let row_sum: f64 = d[i].iter().sum();
             assert!(row_sum.abs() < 1e-12);
             for j in 0..p.len() {
-                assert!((dense[[i, j]] - dense[[j, i]]).abs() < 1e-14);
+                assert!((d[i][j] - d[j][i]).abs() < 1e-14);
             }
         }
         // xᵀ L x = Σ w_ij (x_i − x_j)² ≥ 0 for a test vector (sanity of sign).
@@ -406,45 +316,17 @@ mod tests {
     #[test]
     fn closed_polyhedra_gauss_bonnet() {
         for (name, (p, t)) in [("octahedron", octahedron()), ("icosahedron", icosahedron())] {
-            let b = boundary_vertex_flags(p.len(), &t);
-            assert!(b.iter().all(|f| !f), "{name} has no boundary");
+            let b = vec![false; p.len()];
             let d = angle_defects(&p, &t, &b);
             let total: f64 = d.iter().sum();
             assert!((total - 4.0 * PI).abs() < 1e-12, "{name}: Σ defects = {total}");
             let per = 4.0 * PI / p.len() as f64;
             assert!(d.iter().all(|x| (x - per).abs() < 1e-12), "{name}: regular");
-            // Outward orientation: all dihedral angles equal and convex (positive).
-            let ef: Vec<[u32; 2]> = interior_edge_faces(&t).into_iter().map(|(_, f)| f).collect();
-            assert_eq!(ef.len(), 3 * t.len() / 2);
-            let da = dihedral_angles(&p, &t, &ef);
-            let expect = if name == "octahedron" {
-                PI - (-1.0f64 / 3.0).acos()
-            } else {
-                PI - (-(5f64.sqrt()) / 3.0).acos()
-            };
-            assert!(da.iter().all(|a| (a - expect).abs() < 1e-12), "{name}: {da:?}");
             // Σ M = total area; L·1 = 0.
             let area: f64 = face_areas(&p, &t).iter().sum();
             assert!((vertex_areas(&p, &t).iter().sum::<f64>() - area).abs() < 1e-12);
-            let l = cotan_laplacian(&p, &t);
+            let l = cotan_laplacian_triplets(&p, &t);
             assert!(matvec(&l, &vec![1.0; p.len()]).iter().all(|v| v.abs() < 1e-12));
         }
-    }
-
-    #[test]
-    fn concave_edge_is_negative_and_angles_sum_to_pi() {
-        // Two triangles folded along the x axis: a valley (concave upward side).
-        let p = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1.0, 0.5], [0.5, -1.0, 0.5]];
-        let t = vec![[0, 1, 2], [1, 0, 3]];
-        let da = dihedral_angles(&p, &t, &[[0, 1]]);
-        assert!(da[0] < 0.0, "valley seen from the normals' side is concave: {}", da[0]);
-        let mut p2 = p.clone();
-        p2[2][2] = -0.5;
-        p2[3][2] = -0.5;
-        assert!(dihedral_angles(&p2, &t, &[[0, 1]])[0] > 0.0);
-        for a in corner_angles(&p, &t) {
-            assert!((a.iter().sum::<f64>() - PI).abs() < 1e-14);
-        }
-        assert!(dihedral_angles(&p, &t, &[[0, 0]])[0].is_nan());
     }
 }

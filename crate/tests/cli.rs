@@ -2,6 +2,8 @@
 
 use std::process::{Command, Stdio};
 
+mod common;
+
 const FANDISK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../web/public/samples/fandisk.obj");
 
 #[test]
@@ -31,8 +33,8 @@ fn a_closed_standard_output_ends_the_tool_quietly() {
 fn cones_refines_where_the_features_need_it_as_solve_does() {
     // At 20°, spot's creases include lone edges and doubly constrained
     // triangles: `cones` places on the same refined mesh as `solve`.
-    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes/spot.obj");
-    let out = Command::new(env!("CARGO_BIN_EXE_conemap")).args(["cones", spot, "--sharp", "20", "--json"]).output().unwrap();
+    let spot = common::shared_path("spot.obj");
+    let out = Command::new(env!("CARGO_BIN_EXE_conemap")).arg("cones").arg(&spot).args(["--sharp", "20", "--json"]).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let inserted = report["inserted_vertices"].as_u64().expect("inserted_vertices");

@@ -6,18 +6,11 @@
 //! input edge on both sides ([`Solution::feature_alignment`]).
 
 use conemap::features::FeatureSet;
-use conemap::io::import_path;
 use conemap::mesh::TriMesh;
 use conemap::pipeline::{solve, Solution, SolveOptions, ALIGNED_TOLERANCE};
-use std::path::Path;
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes");
-
-fn load(name: &str) -> TriMesh {
-    let path = Path::new(DIR).join(name);
-    let raw = import_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    TriMesh::from_raw(&raw).expect("valid mesh")
-}
+mod common;
+use common::shared_mesh as load;
 
 /// Solves `mesh` with `features` and checks the map (see the module doc).
 fn check<'a>(label: &str, mesh: &'a TriMesh, features: &'a FeatureSet) -> Solution<'a> {

@@ -7,18 +7,11 @@
 
 use conemap::cones::{BoundaryMode, ConeOptions};
 use conemap::features::FeatureSet;
-use conemap::io::import_path;
 use conemap::mesh::TriMesh;
 use conemap::pipeline::{solve, SolveOptions};
-use std::path::Path;
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes");
-
-fn mesh(name: &str) -> TriMesh {
-    let path = Path::new(DIR).join(name);
-    let raw = import_path(&path).unwrap_or_else(|e| panic!("{}: {e} (the shared meshes must sit next to the checkout)", path.display()));
-    TriMesh::from_raw(&raw).expect("valid mesh")
-}
+mod common;
+use common::shared_mesh as mesh;
 
 /// Distortion of the solve with the boundary `mode`, after checking the map.
 fn distortion(name: &str, input: &TriMesh, mode: BoundaryMode) -> f64 {

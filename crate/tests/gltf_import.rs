@@ -7,6 +7,8 @@ use conemap::io::InputFile;
 use conemap::{ImportError, RawMesh};
 use serde_json::{json, Value};
 
+mod common;
+
 // ---------------------------------------------------------------------------
 // A tiny glTF writer on the library's buffer builder
 // ---------------------------------------------------------------------------
@@ -1003,18 +1005,8 @@ fn write_strip_glb(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<u8> {
 
 #[test]
 fn round_trip_shared_meshes() {
-    let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes"));
-    if !dir.is_dir() {
-        eprintln!("note: {} is absent, skipping the round trip", dir.display());
-        return;
-    }
-    let mut done = 0;
     for name in ["fandisk", "spot", "woody", "alligator"] {
-        let path = dir.join(format!("{name}.obj"));
-        let Ok(text) = std::fs::read_to_string(&path) else {
-            eprintln!("note: {} is absent, skipped", path.display());
-            continue;
-        };
+        let text = std::fs::read_to_string(common::shared_path(&format!("{name}.obj"))).unwrap();
         let (pos, tris) = parse_obj(&text);
         let expect_pos: Vec<[f64; 3]> = as_f64(&pos);
         for (variant, bytes) in [
@@ -1026,9 +1018,7 @@ fn round_trip_shared_meshes() {
             assert_eq!(m.positions, expect_pos, "{name} {variant}");
             assert_eq!(m.triangles, tris, "{name} {variant}");
         }
-        done += 1;
     }
-    eprintln!("round-tripped {done} meshes");
 }
 
 /// The files written by tests/node/make-gltf.mjs: each must hold exactly the
@@ -1041,8 +1031,7 @@ fn make_gltf_fixtures_match_their_obj() {
         env!("CARGO_MANIFEST_DIR"),
         "/../tests/fixtures/gltf"
     ));
-    let shared =
-        std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes"));
+    let shared = std::path::PathBuf::from(common::SHARED_MESHES);
     let mut dirs = vec![committed];
     if let Some(d) = std::env::var_os("CONEMAP_GLTF_FIXTURES") {
         dirs.push(d.into());

@@ -22,9 +22,8 @@ use conemap::io::import_path;
 use conemap::mesh::{analyze, analyze_by_index, MeshReport, TriMesh};
 use conemap::{Problem, RawMesh};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes");
+mod common;
 
 /// (file, V, F, boundary edges, non-manifold edges, components, χ) exactly as
 /// in the README (by source index). The README's components are
@@ -117,30 +116,20 @@ const CLEAN: &[(&str, i64)] = &[
     ("xatlas-duplicate_edge.obj", 0),
 ];
 
-/// All meshes in the folder, imported; None (with a note) when the folder is absent.
-fn meshes() -> Option<BTreeMap<String, RawMesh>> {
-    let dir = Path::new(DIR);
-    if !dir.is_dir() {
-        println!("note: {DIR} not found; skipping the shared-mesh tests");
-        return None;
-    }
-    let mut out = BTreeMap::new();
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
-    paths.sort();
-    for p in paths {
-        let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        let lower = name.to_ascii_lowercase();
-        if !(lower.ends_with(".obj") || lower.ends_with(".gltf") || lower.ends_with(".glb")) {
-            continue;
-        }
-        let raw = import_path(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
-        out.insert(name, raw);
-    }
-    Some(out)
+/// All meshes of the shared folder, imported, by file name (panics when absent).
+fn meshes() -> BTreeMap<String, RawMesh> {
+    common::shared_files()
+        .into_iter()
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            let raw = import_path(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+            (name, raw)
+        })
+        .collect()
 }
 
 fn get<'a>(m: &'a BTreeMap<String, RawMesh>, name: &str) -> &'a RawMesh {
-    m.get(name).unwrap_or_else(|| panic!("{name} missing from {DIR}"))
+    m.get(name).unwrap_or_else(|| panic!("{name} missing from {}", common::SHARED_MESHES))
 }
 
 fn kinds(r: &MeshReport) -> BTreeMap<&'static str, usize> {
@@ -165,7 +154,7 @@ fn kinds(r: &MeshReport) -> BTreeMap<&'static str, usize> {
 
 #[test]
 fn every_file_is_listed_and_matches_the_readme_by_index() {
-    let Some(all) = meshes() else { return };
+    let all = meshes();
     for name in all.keys() {
         assert!(README.iter().any(|r| r.0 == name), "{name} is not in the README table of this test");
         assert!(WELDED.iter().any(|r| r.0 == name), "{name} is not in the welded table of this test");
@@ -185,7 +174,7 @@ fn every_file_is_listed_and_matches_the_readme_by_index() {
 
 #[test]
 fn welded_figures() {
-    let Some(all) = meshes() else { return };
+    let all = meshes();
     for &(name, v, f, e, b, nm, c, chi, loops, merged) in WELDED {
         let r = analyze(get(&all, name));
         assert_eq!(
@@ -209,7 +198,7 @@ fn welded_figures() {
 
 #[test]
 fn clean_meshes_build() {
-    let Some(all) = meshes() else { return };
+    let all = meshes();
     for &(name, genus) in CLEAN {
         let raw = get(&all, name);
         let r = analyze(raw);
@@ -257,7 +246,7 @@ fn problems(all: &BTreeMap<String, RawMesh>, name: &str) -> (MeshReport, Vec<Pro
 
 #[test]
 fn bad_meshes_report_their_problems() {
-    let Some(all) = meshes() else { return };
+    let all = meshes();
     use Problem::*;
 
     // Non-manifold edges.

@@ -6,28 +6,17 @@
 use conemap::cones::ConeOptions;
 use conemap::features::FeatureSet;
 use conemap::pipeline::{solve, SolveOptions};
-use conemap::io::import_path;
 use conemap::mesh::TriMesh;
 use conemap::param::{metrics::uv_angle_sums, ParamOptions};
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::path::Path;
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes");
-
-fn load(name: &str) -> Option<TriMesh> {
-    let path = Path::new(DIR).join(name);
-    if !path.exists() {
-        eprintln!("skipping {name}: {} not found", path.display());
-        return None;
-    }
-    let raw = import_path(&path).expect("import");
-    Some(TriMesh::from_raw(&raw).expect("valid mesh"))
-}
+mod common;
+use common::shared_mesh as load;
 
 /// Solves `name` and checks the map; `max_flip_fraction` is the share of
 /// flipped triangles tolerated (0 except where a known shortfall is stated).
 fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f64) {
-    let Some(input) = load(name) else { return };
+    let input = load(name);
     let features = match sharp {
         Some(deg) => FeatureSet::sharp_edges(&input, deg),
         None => FeatureSet::none(&input),
@@ -108,7 +97,7 @@ fn fandisk_with_sharp_features() {
 /// 85 % of the triangles below 0.3 (paper: 0.226 mean distortion).
 #[test]
 fn fandisk_with_sharp_features_has_85_percent_below_0_3() {
-    let Some(input) = load("fandisk.obj") else { return };
+    let input = load("fandisk.obj");
     let features = FeatureSet::sharp_edges(&input, 60.0);
     let options = SolveOptions { cones: ConeOptions { alpha_smooth: 0.01, ..ConeOptions::default() }, param: ParamOptions::default(), ..SolveOptions::default() };
     let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();

@@ -5,18 +5,12 @@
 //! quarter of its cones and 38 % in distortion: 32 cones, 0.155.)
 
 use conemap::features::FeatureSet;
-use conemap::io::import_path;
 use conemap::mesh::{subdivide_midpoint, RawMesh, TriMesh};
 use conemap::pipeline::{solve, SolveOptions};
 use conemap::vec3;
-use std::path::Path;
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes");
-
-fn raw(name: &str) -> RawMesh {
-    let path = Path::new(DIR).join(name);
-    import_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
+mod common;
+use common::shared_raw as raw;
 
 /// Moves every vertex by up to `amount` of its shortest incident edge along
 /// a deterministic direction projected onto its tangent plane.

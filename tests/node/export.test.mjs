@@ -61,20 +61,18 @@ const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-export-'));
 const woodyObj = sharedMesh('woody');
 
 // Inputs: the committed fandisk.obj, and woody as a one-primitive .glb and a
-// two-mesh .gltf made by make-gltf.mjs (when ../shared/meshes is present).
+// two-mesh .gltf made by make-gltf.mjs.
 // The fixtures are written at load time so each (input, format) pair can be
 // its own test.
 const inputs = [{ label: 'fandisk.obj', file: committedFandisk }];
-if (woodyObj) {
-  for (const w of await makeGltfFixtures(woodyObj, path.join(tmp, 'fixtures'))) {
-    if (w.name === 'woody.glb' || w.name === 'woody-two-nodes.gltf') inputs.push({ label: w.name, file: w.path, faces: w.faces });
-  }
+for (const w of await makeGltfFixtures(woodyObj, path.join(tmp, 'fixtures'))) {
+  if (w.name === 'woody.glb' || w.name === 'woody-two-nodes.gltf') inputs.push({ label: w.name, file: w.path, faces: w.faces });
 }
 
 describe('conemap solve', () => {
   before(() => ensureCli());
 
-  it('has the woody fixtures', { skip: woodyObj ? false : '../shared/meshes/woody.obj absent' }, () => {
+  it('has the woody fixtures', () => {
     assert.ok(inputs.some((i) => i.label === 'woody.glb'));
   });
 
@@ -133,7 +131,7 @@ describe('conemap solve', () => {
     });
   }
 
-  it('keeps the primitives of a two-mesh glTF', { skip: woodyObj ? false : '../shared/meshes/woody.obj absent' }, async () => {
+  it('keeps the primitives of a two-mesh glTF', async () => {
     const input = inputs.find((i) => i.label === 'woody-two-nodes.gltf');
     const out = path.join(tmp, 'two-nodes-out.glb');
     const r = conemap('solve', input.file, '-o', out);

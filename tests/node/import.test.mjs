@@ -44,7 +44,7 @@ describe('wasm import_mesh', () => {
 
   for (const name of ['fandisk', 'spot', 'woody', 'alligator']) {
     const file = sharedMesh(name);
-    it(`imports ../shared/meshes/${name}.obj`, { skip: file ? false : '../shared/meshes absent' }, () => {
+    it(`imports ../shared/meshes/${name}.obj`, () => {
       const out = importFiles(wasm, [file]);
       checkShape(out, EXPECTED[name].faces);
       checkReport(out, EXPECTED[name]);
@@ -103,13 +103,13 @@ function truncatedGlb() {
   return glb.subarray(0, glb.length - 10); // cut inside the JSON chunk
 }
 
-// glTF variants written by tests/node/make-gltf.mjs (when present) must import
-// to the same mesh as the OBJ they came from.
+// glTF variants written by tests/node/make-gltf.mjs must import to the same
+// mesh as the OBJ they came from.
 const makeGltf = path.join(root, 'tests/node/make-gltf.mjs');
-describe('glTF fixtures match their OBJ', { skip: fs.existsSync(makeGltf) ? false : 'tests/node/make-gltf.mjs not written yet' }, () => {
+describe('glTF fixtures match their OBJ', () => {
   for (const name of ['fandisk', 'spot', 'woody']) {
     const obj = name === 'fandisk' ? committedFandisk : sharedMesh(name);
-    it(name, { skip: obj ? false : '../shared/meshes absent' }, async () => {
+    it(name, async () => {
       const { makeGltfFixtures } = await import(makeGltf);
       const dir = fs.mkdtempSync(path.join(os.tmpdir(), `conemap-gltf-${name}-`));
       try {

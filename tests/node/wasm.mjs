@@ -24,9 +24,12 @@ export const EXPECTED = {
   alligator: { vertices: 3208, faces: 5981, euler_characteristic: 1 },
 };
 
+/** Path of ../shared/meshes/NAME.obj; throws when absent (a checkout without
+ *  the shared fixtures must fail, not pass by skipping). */
 export const sharedMesh = (name) => {
   const p = path.join(sharedMeshes, `${name}.obj`);
-  return fs.existsSync(p) ? p : null;
+  if (!fs.existsSync(p)) throw new Error(`fixture ${p} not found: the shared meshes must sit beside the checkout`);
+  return p;
 };
 
 /** Imports files given as paths or {name, bytes}; the first is the mesh. */

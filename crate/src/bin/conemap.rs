@@ -1,8 +1,7 @@
 //! The conemap command-line tool. Thin: argument parsing and printing only.
 //!
 //! `conemap <command> [args]`; each command is one function taking the
-//! arguments after its name, so later commands (`cones`, `solve`) slot into
-//! [`COMMANDS`] and [`run`].
+//! arguments after its name, listed in [`COMMANDS`] and dispatched by [`run`].
 
 use conemap::cones::{self, BoundaryMode, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;

@@ -1,5 +1,5 @@
 //! Sparse linear algebra: a reusable symmetric (indefinite) factorization on
-//! top of faer (OWNER: linalg helper).
+//! top of faer.
 //!
 //! * [`SymmetricPattern`] — fixed upper-triangular CSC pattern built from
 //!   `(row, col, value)` triplets; values travel as slot-ordered `Vec<f64>`

@@ -345,7 +345,7 @@ fn folded_faces(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]], cone_angle: &[f64
 /// (seam transitions along each [`super::cut_graph::SeamCurve`], isolines,
 /// one pin per disk component) to solver accuracy. The KKT matrix is
 /// factored once for Poisson + ARAP; the repair refactors (same pattern);
-/// the refinement has its own pattern (u–v coupling), analysed once. When a
+/// the refinement has its own pattern, analysed once. When a
 /// fold-free map (no flipped triangle, no wound vertex) is found the result
 /// is fold-free and no worse by eq. (19) than that map.
 #[allow(clippy::too_many_arguments)]
