@@ -178,7 +178,7 @@ impl Solution<'_> {
     pub fn flipped_faces(&self) -> Vec<u32> {
         let uv = &self.param.uv;
         (0..self.mesh.n_faces() as u32)
-            .filter(|&f| !(param::seamless::signed_uv_area([0, 1, 2].map(|k| uv[3 * f as usize + k])) > 0.0))
+            .filter(|&f| !(param::element::signed_uv_area([0, 1, 2].map(|k| uv[3 * f as usize + k])) > 0.0))
             .collect()
     }
 

@@ -24,7 +24,7 @@
 //! every vertex (a continuous function of the iterate while no triangle
 //! degenerates) keeps its value: the map never starts to wind around a cone.
 
-use super::seamless::Element;
+use super::element::Element;
 use super::ParamError;
 use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector, SolverOptions, Triplet};
 
@@ -416,13 +416,9 @@ mod tests {
         let nv = mesh.n_vertices();
         let elements = (0..mesh.n_faces() as u32)
             .map(|f| {
-                let (q, area) = super::super::local_triangle(&mesh, f);
-                let g = [0, 1, 2].map(|k| {
-                    let (a, b) = (q[(k + 1) % 3], q[(k + 2) % 3]);
-                    [-(b[1] - a[1]) / (2.0 * area), (b[0] - a[0]) / (2.0 * area)]
-                });
+                let (q, area) = super::super::element::local_triangle(&mesh, f);
                 let w = mesh.faces()[f as usize].map(|v| v as usize);
-                Element { w, x: [w, w.map(|i| nv + i)], g, area }
+                Element::new(q, area, w, [w, w.map(|i| nv + i)])
             })
             .collect();
         let on = |pred: &dyn Fn([f64; 3]) -> bool, key: usize| {

@@ -2,8 +2,7 @@
 //! at the best global scale, flips, seamlessness and alignment residuals.
 
 use super::cut_graph::CutGraph;
-use super::local_triangle;
-use super::seamless::signed_uv_area;
+use super::element::{self, hat_gradients, local_triangle, signed_uv_area};
 use crate::cones::ConePlacement;
 use crate::mesh::TriMesh;
 use serde::Serialize;
@@ -53,17 +52,8 @@ pub fn face_jacobians(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<([[f64; 2]; 2], f6
     (0..mesh.n_faces() as u32)
         .map(|f| {
             let (q, area) = local_triangle(mesh, f);
-            let mut j = [[0.0; 2]; 2];
-            for k in 0..3 {
-                let (a, b) = (q[(k + 1) % 3], q[(k + 2) % 3]);
-                let g = [-(b[1] - a[1]) / (2.0 * area), (b[0] - a[0]) / (2.0 * area)];
-                let p = uv[3 * f as usize + k];
-                for c in 0..2 {
-                    j[c][0] += p[c] * g[0];
-                    j[c][1] += p[c] * g[1];
-                }
-            }
-            (j, area)
+            let p = [0, 1, 2].map(|k| uv[3 * f as usize + k]);
+            (element::jacobian(&hat_gradients(q, area), p), area)
         })
         .collect()
 }
@@ -89,37 +79,36 @@ pub fn uv_angle_sums(mesh: &TriMesh, uv: &[[f64; 2]]) -> Vec<f64> {
     angle_sums(mesh, uv, false)
 }
 
-/// UV corner angles summed per vertex; with `signed`, the angles of
-/// flipped triangles (UV area < 0) count negative.
+/// UV corner angles summed per vertex (UV per corner `3 f + k`); with
+/// `signed`, the angles of flipped triangles count negative.
 fn angle_sums(mesh: &TriMesh, uv: &[[f64; 2]], signed: bool) -> Vec<f64> {
-    let mut sums = vec![0.0; mesh.n_vertices()];
-    for (f, t) in mesh.faces().iter().enumerate() {
-        let flipped = signed && signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]) < 0.0;
-        for k in 0..3 {
-            let angle = corner_angle(uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
-            sums[t[k] as usize] += if flipped { -angle } else { angle };
+    element::angle_sums(mesh.faces(), mesh.n_vertices(), |f| [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]], signed)
+}
+
+/// Cone angle `2 pi - k pi/2` of every interior vertex of `mesh` that is not
+/// on a feature (NaN elsewhere), from the cone placement.
+pub(crate) fn interior_cone_angles(mesh: &TriMesh, placement: &ConePlacement) -> Vec<f64> {
+    let mut angle = vec![f64::NAN; mesh.n_vertices()];
+    let cut = &placement.cut;
+    for (cv, &v) in cut.original_vertex.iter().enumerate() {
+        if !cut.mesh.is_boundary_vertex(cv as u32) {
+            angle[v as usize] = 2.0 * std::f64::consts::PI - placement.k[cv] as f64 * std::f64::consts::FRAC_PI_2;
         }
     }
-    sums
+    angle
 }
 
 /// Interior vertices where the map folds ([`Metrics::wound_vertices`]):
 /// signed UV angle sum off the vertex's cone angle by more than pi.
 pub fn wound_vertices(mesh: &TriMesh, placement: &ConePlacement, uv: &[[f64; 2]]) -> Vec<u32> {
     let sums = angle_sums(mesh, uv, true);
-    let cone_angle = super::seamless::interior_cone_angles(mesh, placement);
+    let cone_angle = interior_cone_angles(mesh, placement);
     (0..mesh.n_vertices() as u32)
         .filter(|&v| {
             let expected = cone_angle[v as usize];
             expected.is_finite() && (sums[v as usize] - expected).abs() > std::f64::consts::PI
         })
         .collect()
-}
-
-/// Unsigned UV angle at corner `p` of the triangle `(p, a, b)`.
-pub(super) fn corner_angle(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (x, y) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
-    (x[0] * y[1] - x[1] * y[0]).atan2(x[0] * y[0] + x[1] * y[1]).abs()
 }
 
 /// Angle (radians) from `angle` to the nearest multiple of 90°.

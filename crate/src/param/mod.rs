@@ -5,6 +5,10 @@
 //! the untangling of what the repair left flipped ([`untangle`]), an
 //! injective (flip-free) refinement under the same constraints
 //! ([`injective`]), and the quality figures of section 7 ([`metrics`], eq. 19).
+//! The four share the linear triangle element of [`element`] (face frames,
+//! hat gradients, Jacobians, UV areas and angles) and import no one else's
+//! internals: `seamless` drives `injective` and `untangle`, and measures
+//! with `metrics`.
 //!
 //! An untangled map has every triangle positive but may realize some
 //! angles differently from the placement: inside, the placed cone angle
@@ -20,6 +24,7 @@
 //! and boundary edge on an isoline.
 
 pub mod cut_graph;
+pub mod element;
 pub mod field;
 pub mod injective;
 pub mod metrics;
@@ -285,22 +290,3 @@ fn check_inputs(mesh: &TriMesh, placement: &ConePlacement) -> Result<(), ParamEr
     }
     Ok(())
 }
-
-/// Local 2D coordinates of the corners of face `f` in its frame (x along the
-/// first edge, y = n × x, as `cones::frames::Frames`), corner 0 at the origin,
-/// and the face area.
-pub(crate) fn local_triangle(mesh: &TriMesh, f: u32) -> ([[f64; 2]; 3], f64) {
-    let t = mesh.faces()[f as usize];
-    let p = t.map(|v| mesh.position(v));
-    let e0 = sub(p[1], p[0]);
-    let e2 = sub(p[2], p[0]);
-    let l0 = dot(e0, e0).sqrt();
-    let x = [e0[0] / l0, e0[1] / l0, e0[2] / l0];
-    let n = cross(e0, e2);
-    let nn = dot(n, n).sqrt();
-    let nu = [n[0] / nn, n[1] / nn, n[2] / nn];
-    let y = cross(nu, x);
-    ([[0.0, 0.0], [l0, 0.0], [dot(e2, x), dot(e2, y)]], 0.5 * nn)
-}
-
-pub(crate) use crate::vec3::{cross, dot, sub};

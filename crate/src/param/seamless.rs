@@ -11,8 +11,9 @@ use super::cut_graph::CutGraph;
 use super::field::{CrossField, NO_ISOLINE};
 use super::injective::{RefineOptions, Refiner};
 use super::untangle::untangle;
-use super::metrics::{self, corner_angle};
-use super::{local_triangle, ParamError, ParamOptions, ParamProgress, ParamTimings};
+use super::element::{angle_sums, local_triangle, signed_uv_area, Element};
+use super::metrics::{self, interior_cone_angles};
+use super::{ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
 use crate::linalg::{constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, SolveError, SolverOptions, Triplet};
@@ -58,33 +59,6 @@ pub struct SeamlessResult {
     pub realized: Vec<(u32, i32)>,
     /// Final ARAP energy `sum_f A_f |J_f - R_f|^2`.
     pub energy: f64,
-}
-
-/// Per-face linear-element data.
-pub(super) struct Element {
-    /// Wedges of the three corners.
-    pub(super) w: [usize; 3],
-    /// Unknowns of the corners' u and v.
-    pub(super) x: [[usize; 3]; 2],
-    /// Gradients of the three hat functions in the face frame.
-    pub(super) g: [[f64; 2]; 3],
-    pub(super) area: f64,
-}
-
-impl Element {
-    /// Jacobian (rows: u and v gradients in the face frame) for the unknown
-    /// vector `x`.
-    pub(super) fn jacobian(&self, x: &[f64]) -> [[f64; 2]; 2] {
-        let mut j = [[0.0; 2]; 2];
-        for k in 0..3 {
-            for c in 0..2 {
-                let p = x[self.x[c][k]];
-                j[c][0] += p * self.g[k][0];
-                j[c][1] += p * self.g[k][1];
-            }
-        }
-        j
-    }
 }
 
 /// The constrained system on the shared unknowns of [`unknowns`].
@@ -214,17 +188,9 @@ impl System {
         constraint_values(&self.constraints, self.n_rows, x).iter().fold(0.0f64, |m, v| m.max(v.abs()))
     }
 
+    /// Jacobian of face `f` for UV per wedge.
     fn jacobian(&self, f: usize, uv: &[[f64; 2]]) -> [[f64; 2]; 2] {
-        let el = &self.elements[f];
-        let mut j = [[0.0; 2]; 2];
-        for k in 0..3 {
-            let p = uv[el.w[k]];
-            for c in 0..2 {
-                j[c][0] += p[c] * el.g[k][0];
-                j[c][1] += p[c] * el.g[k][1];
-            }
-        }
-        j
+        self.elements[f].wedge_jacobian(uv)
     }
 }
 
@@ -244,31 +210,9 @@ fn frob2(j: [[f64; 2]; 2], r: [[f64; 2]; 2]) -> f64 {
     (0..2).flat_map(|a| (0..2).map(move |b| (a, b))).map(|(a, b)| (j[a][b] - r[a][b]).powi(2)).sum()
 }
 
-/// Signed UV area of face `f` relative to its orientation (≤ 0: flipped or degenerate).
-pub fn signed_uv_area(uv: [[f64; 2]; 3]) -> f64 {
-    0.5 * ((uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[2][0] - uv[0][0]) * (uv[1][1] - uv[0][1]))
-}
-
+/// Faces whose UV triangle (per wedge) is flipped or degenerate.
 fn flipped_faces(sys: &System, uv: &[[f64; 2]]) -> Vec<usize> {
-    (0..sys.elements.len())
-        .filter(|&f| {
-            let w = sys.elements[f].w;
-            !(signed_uv_area([uv[w[0]], uv[w[1]], uv[w[2]]]) > 0.0)
-        })
-        .collect()
-}
-
-/// Cone angle `2 pi - k pi/2` of every interior vertex of `mesh` that is not
-/// on a feature (NaN elsewhere), from the cone placement.
-pub(crate) fn interior_cone_angles(mesh: &TriMesh, placement: &ConePlacement) -> Vec<f64> {
-    let mut angle = vec![f64::NAN; mesh.n_vertices()];
-    let cut = &placement.cut;
-    for (cv, &v) in cut.original_vertex.iter().enumerate() {
-        if !cut.mesh.is_boundary_vertex(cv as u32) {
-            angle[v as usize] = 2.0 * std::f64::consts::PI - placement.k[cv] as f64 * std::f64::consts::FRAC_PI_2;
-        }
-    }
-    angle
+    (0..sys.elements.len()).filter(|&f| !(signed_uv_area(sys.elements[f].uv(uv)) > 0.0)).collect()
 }
 
 /// The cones and boundary corners of a map with every triangle positive
@@ -284,13 +228,7 @@ pub(crate) fn interior_cone_angles(mesh: &TriMesh, placement: &ConePlacement) ->
 fn realized_cones(placement: &ConePlacement, sys: &System, uv: &[[f64; 2]], cone_angle: &mut [f64]) -> Vec<(u32, i32)> {
     use std::f64::consts::{FRAC_PI_2, PI};
     let cm = &placement.cut.mesh;
-    let mut sums = vec![0.0; cm.n_vertices()];
-    for (f, tri) in cm.faces().iter().enumerate() {
-        let w = sys.elements[f].w;
-        for k in 0..3 {
-            sums[tri[k] as usize] += corner_angle(uv[w[k]], uv[w[(k + 1) % 3]], uv[w[(k + 2) % 3]]);
-        }
-    }
+    let sums = angle_sums(cm.faces(), cm.n_vertices(), |f| sys.elements[f].uv(uv), false);
     let mut out = Vec::new();
     for (cv, &sum) in sums.iter().enumerate() {
         if placement.cut.touches_free(cv as u32) {
@@ -309,24 +247,12 @@ fn realized_cones(placement: &ConePlacement, sys: &System, uv: &[[f64; 2]], cone
     out
 }
 
-/// UV angle sum at every vertex of `mesh` (unsigned corner angles).
-fn wedge_angle_sums(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]]) -> Vec<f64> {
-    let mut sums = vec![0.0; mesh.n_vertices()];
-    for (f, tri) in mesh.faces().iter().enumerate() {
-        let w = sys.elements[f].w;
-        for k in 0..3 {
-            sums[tri[k] as usize] += corner_angle(uv[w[k]], uv[w[(k + 1) % 3]], uv[w[(k + 2) % 3]]);
-        }
-    }
-    sums
-}
-
 /// Flipped faces plus the faces around interior vertices whose UV angle sum
 /// is off their cone angle by more than pi: the map winds around such a
 /// vertex more than once although no triangle is flipped.
 fn folded_faces(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]], cone_angle: &[f64]) -> Vec<usize> {
     let mut bad = flipped_faces(sys, uv);
-    let sums = wedge_angle_sums(mesh, sys, uv);
+    let sums = angle_sums(mesh.faces(), mesh.n_vertices(), |f| sys.elements[f].uv(uv), false);
     for v in 0..mesh.n_vertices() as u32 {
         let expected = cone_angle[v as usize];
         if expected.is_finite() && (sums[v as usize] - expected).abs() > std::f64::consts::PI {
@@ -366,14 +292,9 @@ pub fn solve(
     let elements: Vec<Element> = (0..nf as u32)
         .map(|f| {
             let (q, area) = local_triangle(mesh, f);
-            // grad phi_k = rot90(q_{k+2} - q_{k+1}) / (2 A).
-            let g = [0, 1, 2].map(|k| {
-                let (a, b) = (q[(k + 1) % 3], q[(k + 2) % 3]);
-                [-(b[1] - a[1]) / (2.0 * area), (b[0] - a[0]) / (2.0 * area)]
-            });
             let c = 3 * f as usize;
             let w = [0, 1, 2].map(|k| cut.wedge[c + k] as usize);
-            Element { w, x: [w.map(|i| vars[0][i]), w.map(|i| vars[1][i])], g, area }
+            Element::new(q, area, w, [w.map(|i| vars[0][i]), w.map(|i| vars[1][i])])
         })
         .collect();
 

@@ -81,7 +81,7 @@ fn mismatched_placement_is_an_error() {
 fn min_area_ratio(mesh: &TriMesh, uv: &[[f64; 2]]) -> f64 {
     let areas = crate::operators::face_areas(mesh.positions(), mesh.faces());
     let uv_areas: Vec<f64> = (0..mesh.n_faces())
-        .map(|f| seamless::signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]))
+        .map(|f| element::signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]))
         .collect();
     let scale = areas.iter().sum::<f64>() / uv_areas.iter().sum::<f64>();
     (0..mesh.n_faces()).map(|f| uv_areas[f] * scale / areas[f]).fold(f64::INFINITY, f64::min)

@@ -21,7 +21,7 @@
 //! to the mesh (with projected gradients alone L-BFGS made little progress
 //! on the cow).
 
-use super::seamless::Element;
+use super::element::Element;
 
 /// Weight `theta` of the area term. The paper's 1/128 is for maps with a
 /// fixed boundary; here nothing is fixed but one pin per component, and
@@ -273,11 +273,7 @@ mod tests {
                 for w in [[id(i, j), id(i + 1, j), id(i + 1, j + 1)], [id(i, j), id(i + 1, j + 1), id(i, j + 1)]] {
                     let q = w.map(|k| p[k]);
                     let area = 0.5 * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]));
-                    let g = [0, 1, 2].map(|k| {
-                        let (a, b) = (q[(k + 1) % 3], q[(k + 2) % 3]);
-                        [-(b[1] - a[1]) / (2.0 * area), (b[0] - a[0]) / (2.0 * area)]
-                    });
-                    elements.push(Element { w, x: [w, w.map(|k| k + n * n)], g, area });
+                    elements.push(Element::new(q, area, w, [w, w.map(|k| k + n * n)]));
                 }
             }
         }
