@@ -47,7 +47,7 @@ impl Default for RefineOptions {
 /// Progress of either stage.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SolveProgress {
-    Cones(cones::Progress),
+    Cones(cones::ConeProgress),
     Param(ParamProgress),
 }
 
@@ -335,7 +335,7 @@ pub fn place_cones(
     mesh: &TriMesh,
     features: &FeatureSet,
     options: &SolveOptions,
-    progress: &mut dyn FnMut(cones::Progress),
+    progress: &mut dyn FnMut(cones::ConeProgress),
 ) -> Result<Placed, SolveError> {
     ConeStage::new(mesh, features, options).place(mesh, features, progress)
 }
@@ -411,7 +411,7 @@ impl ConeStage {
     }
 
     /// Places every component here ([`cones::place_all`]) and completes the stage.
-    fn place(self, mesh: &TriMesh, features: &FeatureSet, progress: &mut dyn FnMut(cones::Progress)) -> Result<Placed, SolveError> {
+    fn place(self, mesh: &TriMesh, features: &FeatureSet, progress: &mut dyn FnMut(cones::ConeProgress)) -> Result<Placed, SolveError> {
         let results = cones::place_all(self.problem(), progress).map_err(|e| self.cone_error(mesh, features, e))?;
         self.complete(mesh, features, results, progress)
     }
@@ -425,7 +425,7 @@ impl ConeStage {
         mesh: &TriMesh,
         features: &FeatureSet,
         results: Vec<ComponentPlacement>,
-        progress: &mut dyn FnMut(cones::Progress),
+        progress: &mut dyn FnMut(cones::ConeProgress),
     ) -> Result<Placed, SolveError> {
         let (mut stage, mut results) = (self, results);
         loop {

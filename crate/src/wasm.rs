@@ -3,7 +3,7 @@
 //! Errors cross as JS `Error`s carrying the library's one-line message; solve
 //! errors that name mesh elements also carry `location` ([`solve_error`]).
 
-use crate::cones::{self, BoundaryMode, ComponentPlacement, ConeOptions, ConePlacement, Progress};
+use crate::cones::{self, BoundaryMode, ComponentPlacement, ConeOptions, ConePlacement, ConeProgress};
 use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::{self, ParamOptions, ParamProgress};
 use crate::pipeline::{ConeStage, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
@@ -364,7 +364,7 @@ fn notify(progress: &Function, stage: &str, a: usize, b: usize) {
 }
 
 /// Forwards cone-placement progress to the page's `progress`.
-fn cone_progress(progress: &Function) -> impl FnMut(Progress) + '_ {
+fn cone_progress(progress: &Function) -> impl FnMut(ConeProgress) + '_ {
     move |p| {
         let (stage, a, b) = cone_stage(&p);
         notify(progress, stage, a, b);
@@ -372,12 +372,12 @@ fn cone_progress(progress: &Function) -> impl FnMut(Progress) + '_ {
 }
 
 /// Stage name and two counters of a cone-placement progress report.
-fn cone_stage(p: &Progress) -> (&'static str, usize, usize) {
+fn cone_stage(p: &ConeProgress) -> (&'static str, usize, usize) {
     match *p {
-        Progress::Topology { component, components } => ("topology", component, components),
-        Progress::Rounding { round, free, .. } => ("rounding", round, free),
-        Progress::ConeMoves { pass, .. } => ("cone moves", pass, 0),
-        Progress::PairCancellation { removed, .. } => ("pair cancellation", removed, 0),
+        ConeProgress::Topology { component, components } => ("topology", component, components),
+        ConeProgress::Rounding { round, free, .. } => ("rounding", round, free),
+        ConeProgress::ConeMoves { pass, .. } => ("cone moves", pass, 0),
+        ConeProgress::PairCancellation { removed, .. } => ("pair cancellation", removed, 0),
     }
 }
 

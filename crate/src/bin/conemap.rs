@@ -376,8 +376,8 @@ impl ProgressLine {
         }
     }
 
-    fn cones(&self, p: &cones::Progress) {
-        use cones::Progress::*;
+    fn cones(&self, p: &cones::ConeProgress) {
+        use cones::ConeProgress::*;
         self.say(|| match *p {
             Topology { component, components } => format!("cones: component {} of {components}, path basis", component + 1),
             Rounding { component, round, free } => {

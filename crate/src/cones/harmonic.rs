@@ -10,7 +10,7 @@
 
 use super::dual_tree::{orientation, DualTree};
 use super::frames::Visit;
-use crate::linalg::{SolveError, SparseSpd, Triplet};
+use crate::linalg::{LinalgError, SparseSpd, Triplet};
 use crate::mesh::{TriMesh, NONE};
 use crate::operators;
 
@@ -26,7 +26,7 @@ pub struct HarmonicBasis {
 
 impl HarmonicBasis {
     /// Computes the forms for the leftovers of `tree`.
-    pub fn new(mesh: &TriMesh, tree: &DualTree) -> Result<HarmonicBasis, SolveError> {
+    pub fn new(mesh: &TriMesh, tree: &DualTree) -> Result<HarmonicBasis, LinalgError> {
         let n_h = tree.leftovers.len();
         if n_h == 0 {
             return Ok(HarmonicBasis { u: Vec::new(), gram: Vec::new() });

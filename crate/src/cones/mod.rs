@@ -107,7 +107,7 @@ impl Default for ConeOptions {
 
 /// Progress reports, in order.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Progress {
+pub enum ConeProgress {
     /// Building the path basis and harmonic forms of component `component`.
     Topology { component: usize, components: usize },
     /// Rounding round `round`: `free` integers still unrounded.
@@ -141,7 +141,7 @@ pub struct ConeTimings {
 
 /// Per-component figures.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct ComponentCones {
+pub struct ComponentFigures {
     pub euler_characteristic: i64,
     pub boundary_loops: usize,
     pub genus: i64,
@@ -180,7 +180,7 @@ pub struct ConePlacement {
     pub cones: Vec<Cone>,
     /// Corners of the input mesh's boundary.
     pub boundary_corners: Vec<Cone>,
-    pub components: Vec<ComponentCones>,
+    pub components: Vec<ComponentFigures>,
     /// `phiᵀ(alpha L + M/A) phi` summed over components.
     pub energy: f64,
     /// Area-weighted RMS of `phi`.
@@ -217,7 +217,7 @@ pub fn place_cones(
     mesh: &TriMesh,
     features: &FeatureSet,
     options: &ConeOptions,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(ConeProgress),
 ) -> Result<ConePlacement, ConeError> {
     let mut clock = Stopwatch::start();
     let problem = ConeProblem::new(mesh, features, options);
@@ -229,13 +229,13 @@ pub fn place_cones(
 
 /// Places every component of `problem`, largest first; natively on two
 /// threads pulling from one queue, in wasm32 one after the other.
-pub fn place_all(problem: &ConeProblem, progress: &mut dyn FnMut(Progress)) -> Result<Vec<ComponentPlacement>, ConeError> {
+pub fn place_all(problem: &ConeProblem, progress: &mut dyn FnMut(ConeProgress)) -> Result<Vec<ComponentPlacement>, ConeError> {
     let order = problem.schedule();
     #[cfg(not(target_arch = "wasm32"))]
     if order.len() > 1 {
         use std::sync::atomic::{AtomicUsize, Ordering};
         let next = AtomicUsize::new(0);
-        let drain = |progress: &mut dyn FnMut(Progress)| -> Result<Vec<ComponentPlacement>, ConeError> {
+        let drain = |progress: &mut dyn FnMut(ConeProgress)| -> Result<Vec<ComponentPlacement>, ConeError> {
             let mut out = Vec::new();
             while let Some(&c) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
                 match problem.place_component(c, progress) {

@@ -7,7 +7,7 @@
 
 use super::frames::{Frames, Visit};
 use super::system::{ComponentSystem, Weights};
-use super::{original_cones, BoundaryMode, ComponentCones, ConeError, ConeOptions, ConePlacement, ConeTimings, Progress};
+use super::{original_cones, BoundaryMode, ComponentFigures, ConeError, ConeOptions, ConePlacement, ConeTimings, ConeProgress};
 use crate::clock::Stopwatch;
 use crate::features::{boundary_turning, cut_open, CutMesh, FeatureSet};
 use crate::mesh::{decimate_interior, TriMesh};
@@ -41,7 +41,7 @@ pub struct ComponentPlacement {
     /// Faces of the component, with `omega` of their 3 midline segments each.
     pub faces: Vec<u32>,
     pub omega: Vec<f64>,
-    pub figures: ComponentCones,
+    pub figures: ComponentFigures,
     /// `phiᵀ(alpha L + M/A) phi` of the component, `|phi|²` times its area, its area.
     pub energy: f64,
     pub phi2_area: f64,
@@ -63,16 +63,16 @@ fn improve(
     sys: &mut ComponentSystem,
     options: &ConeOptions,
     c: usize,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(ConeProgress),
 ) -> Result<(usize, usize, usize, usize), ConeError> {
     let moves = if options.optimize_locations {
-        sys.optimize_locations(options.max_move_passes, &mut |pass| progress(Progress::ConeMoves { component: c, pass }))?
+        sys.optimize_locations(options.max_move_passes, &mut |pass| progress(ConeProgress::ConeMoves { component: c, pass }))?
     } else {
         0
     };
     let merged = if options.merge_close_pairs { sys.merge_close_pairs()? } else { 0 };
     let cancelled = if options.cancel_pairs_nearest > 0 {
-        sys.cancel_pairs(options.cancel_pairs_nearest, &mut |n| progress(Progress::PairCancellation { component: c, removed: n }))?
+        sys.cancel_pairs(options.cancel_pairs_nearest, &mut |n| progress(ConeProgress::PairCancellation { component: c, removed: n }))?
     } else {
         0
     };
@@ -151,11 +151,11 @@ impl ConeProblem {
 
     /// Places the cones of component `c` (< [`Self::n_components`]): system,
     /// Algorithm 1, cone moves and the optional clean-ups.
-    pub fn place_component(&self, c: usize, progress: &mut dyn FnMut(Progress)) -> Result<ComponentPlacement, ConeError> {
+    pub fn place_component(&self, c: usize, progress: &mut dyn FnMut(ConeProgress)) -> Result<ComponentPlacement, ConeError> {
         let mut clock = Stopwatch::start();
         let (cm, frames, options) = (&self.cut.mesh, &self.frames, &self.options);
         let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
-        progress(Progress::Topology { component: c, components: self.n_components() });
+        progress(ConeProgress::Topology { component: c, components: self.n_components() });
         let mut sys = ComponentSystem::new(cm, frames, self.seeds[c], &self.boundary_k, &self.cut.free, weights)?;
         sys.rounding = options.rounding;
         let topology_seconds = clock.lap();
@@ -166,7 +166,7 @@ impl ConeProblem {
             }
         }
         if rounds.is_none() {
-            sys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free }))?;
+            sys.round_all(&mut |round, free| progress(ConeProgress::Rounding { component: c, round, free }))?;
         }
         let rounding_seconds = clock.lap();
         // Placed coarse, the cones only move here: the clean-ups ran on the
@@ -197,7 +197,7 @@ impl ConeProblem {
             }
         }
         let area: f64 = faces.iter().map(|&f| frames.area(f)).sum();
-        let figures = ComponentCones {
+        let figures = ComponentFigures {
             euler_characteristic: cm.component_euler_characteristic(c),
             boundary_loops: cm.component_boundary_loops(c),
             genus: cm.genus(c),
@@ -234,7 +234,7 @@ impl ConeProblem {
     /// feature curves kept, so the boundary integers are the same), and the
     /// rounds that took; `None` when the component is small enough to place
     /// directly or the coarse placement fails (the caller then rounds here).
-    fn coarse_indices(&self, c: usize, sys: &ComponentSystem, progress: &mut dyn FnMut(Progress)) -> Option<(Vec<i64>, usize)> {
+    fn coarse_indices(&self, c: usize, sys: &ComponentSystem, progress: &mut dyn FnMut(ConeProgress)) -> Option<(Vec<i64>, usize)> {
         let (cm, options) = (&self.cut.mesh, &self.options);
         let vertices = &sys.tree.vertices;
         let interior = vertices.iter().filter(|&&v| !cm.is_boundary_vertex(v)).count();
@@ -299,7 +299,7 @@ impl ConeProblem {
             lsys.rounding = options.rounding;
             match &k_sub {
                 None => {
-                    lsys.round_all(&mut |round, free| progress(Progress::Rounding { component: c, round, free })).ok()?;
+                    lsys.round_all(&mut |round, free| progress(ConeProgress::Rounding { component: c, round, free })).ok()?;
                     rounds = lsys.rounds;
                     improve(&mut lsys, options, c, &mut |_| {}).ok()?;
                 }

@@ -20,7 +20,7 @@ use super::dual_tree::{is_free_edge, DualTree};
 use super::frames::{vertex_cycle, Frames, Visit};
 use super::harmonic::HarmonicBasis;
 use super::RoundingRule;
-use crate::linalg::{FixBorder, Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
+use crate::linalg::{FixBorder, Kkt, LdltSolver, LinalgError, FactorOptions, Triplet};
 use crate::mesh::{TriMesh, NONE};
 use crate::vec3;
 use std::f64::consts::FRAC_PI_2;
@@ -116,7 +116,7 @@ pub struct ComponentSystem<'a> {
     /// integer is given, and the curvature equation gives `phi` and `h~`).
     solver: Option<LdltSolver>,
     /// Options of the KKT solver (kept while it is not built).
-    solver_options: SolverOptions,
+    solver_options: FactorOptions,
     /// Slot of each fix row's coefficient `t_e` in the KKT values.
     fix_slots: Vec<usize>,
     /// Slot of each fix row's diagonal (`-1` while the row is inactive, so
@@ -151,13 +151,13 @@ pub struct ComponentSystem<'a> {
 /// What went wrong while placing cones.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ConeError {
-    Solve(SolveError),
+    Solve(LinalgError),
     /// The boundary turning integers admit no integer path values (an internal inconsistency).
     InconsistentBoundary { vertex: u32 },
 }
 
-impl From<SolveError> for ConeError {
-    fn from(e: SolveError) -> Self {
+impl From<LinalgError> for ConeError {
+    fn from(e: LinalgError) -> Self {
         ConeError::Solve(e)
     }
 }
@@ -389,7 +389,7 @@ impl<'a> ComponentSystem<'a> {
             constraint_rhs: rhs,
             kkt,
             solver: None,
-            solver_options: SolverOptions { max_refinement_steps: 50, ..SolverOptions::default() },
+            solver_options: FactorOptions { max_refinement_steps: 50, ..FactorOptions::default() },
             fix_slots,
             fix_diag_slots,
             border: FixBorder::default(),
@@ -438,7 +438,7 @@ impl<'a> ComponentSystem<'a> {
     }
 
     /// Sets the KKT solver's options (now, or when it is built).
-    fn set_solver_options(&mut self, options: SolverOptions) {
+    fn set_solver_options(&mut self, options: FactorOptions) {
         self.solver_options = options;
         if let Some(solver) = &mut self.solver {
             solver.set_options(options);
@@ -461,9 +461,9 @@ impl<'a> ComponentSystem<'a> {
             let options = self.solver_options;
             match result {
                 Err(ConeError::Solve(
-                    SolveError::ZeroPivot { .. } | SolveError::NotFinite { .. } | SolveError::NotConverged { .. },
+                    LinalgError::ZeroPivot { .. } | LinalgError::NotFinite { .. } | LinalgError::NotConverged { .. },
                 )) if options.delta < MAX_DELTA => {
-                    self.set_solver_options(SolverOptions { delta: options.delta * 100.0, ..options });
+                    self.set_solver_options(FactorOptions { delta: options.delta * 100.0, ..options });
                 }
                 Ok(()) => {
                     // Rounds until the next factorization change only held fix rows.
@@ -554,7 +554,7 @@ impl<'a> ComponentSystem<'a> {
         // Integers the rows cannot all meet (e.g. a pin row the given
         // indices contradict) are an error, as the KKT's solve would be.
         if residual.is_nan() || residual > self.accept_residual() {
-            return Err(SolveError::NotConverged { relative_residual: residual, steps: 0 }.into());
+            return Err(LinalgError::NotConverged { relative_residual: residual, steps: 0 }.into());
         }
         self.residual = residual;
         self.x = x;
@@ -642,10 +642,10 @@ impl<'a> ComponentSystem<'a> {
         // Rounding decisions need far less than the final accuracy: solve
         // intermediate rounds to ROUNDING_TOLERANCE, the last one exactly.
         let exact = self.solver_options;
-        self.set_solver_options(SolverOptions { tolerance: ROUNDING_TOLERANCE.max(exact.tolerance), ..exact });
+        self.set_solver_options(FactorOptions { tolerance: ROUNDING_TOLERANCE.max(exact.tolerance), ..exact });
         let rounded = self.round_loop(progress);
         let options = self.solver_options;
-        self.set_solver_options(SolverOptions { tolerance: exact.tolerance, ..options });
+        self.set_solver_options(FactorOptions { tolerance: exact.tolerance, ..options });
         rounded?;
         // Later stages change only right-hand sides: with every integer
         // fixed, the curvature equation; else (free ports) a factorization

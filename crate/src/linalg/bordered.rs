@@ -17,7 +17,7 @@
 //! the true matrix.
 
 use super::cholesky::LdltSolver;
-use super::SolveError;
+use super::LinalgError;
 use nalgebra::{DMatrix, DVector};
 
 /// The variables activated since the last factorization and their columns `Z`.
@@ -61,7 +61,7 @@ impl FixBorder {
 
     /// Activates the fix rows of `fixes` (`(variable, fix row)` pairs): one
     /// blocked solve with `K0` for all their columns.
-    pub fn push(&mut self, solver: &LdltSolver, fixes: &[(usize, usize)]) -> Result<(), SolveError> {
+    pub fn push(&mut self, solver: &LdltSolver, fixes: &[(usize, usize)]) -> Result<(), LinalgError> {
         if fixes.is_empty() {
             return Ok(());
         }
@@ -81,7 +81,7 @@ impl FixBorder {
 
     /// Solves the bordered system for the full right-hand side `b` (length
     /// of `K`; the entries at the held fix rows are the fixed values).
-    pub fn solve(&self, solver: &LdltSolver, b: &[f64]) -> Result<Vec<f64>, SolveError> {
+    pub fn solve(&self, solver: &LdltSolver, b: &[f64]) -> Result<Vec<f64>, LinalgError> {
         let Some(schur) = &self.schur else {
             return solver.solve_unrefined(b);
         };
@@ -94,7 +94,7 @@ impl FixBorder {
             _ => solver.solve_unrefined(&r)?,
         };
         let rhs = DVector::from_iterator(self.fixes.len(), self.fixes.iter().map(|&(var, row)| x[var] - b[row]));
-        let lambda = schur.solve(&rhs).ok_or(SolveError::NotFinite { what: "bordered Schur complement" })?;
+        let lambda = schur.solve(&rhs).ok_or(LinalgError::NotFinite { what: "bordered Schur complement" })?;
         for (z, &l) in self.columns.iter().zip(lambda.iter()) {
             for (xi, zi) in x.iter_mut().zip(z) {
                 *xi -= zi * l;

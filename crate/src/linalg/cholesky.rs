@@ -20,7 +20,7 @@ use faer::{Conj, MatMut, Par, Side, Spec};
 
 use super::pattern::{SymmetricPattern, Triplet};
 use super::krylov::gmres;
-use super::SolveError;
+use super::LinalgError;
 
 /// Refinement whose residual falls by less than this factor in a step is
 /// stagnating: the column is finished by GMRES ([`super::krylov`]).
@@ -33,10 +33,10 @@ const KRYLOV_RESTART: usize = 30;
 /// Tuning of [`LdltSolver`] / [`SparseSpd`]. `delta` and `epsilon` are
 /// *relative* to the largest absolute matrix entry of the factorized values.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SolverOptions {
+pub struct FactorOptions {
     /// Dynamic regularization: a pivot that is below `epsilon` in magnitude or
     /// has the wrong sign is replaced by `±delta` (LDLᵀ only). `0` disables
-    /// regularization (a zero pivot then gives [`SolveError::ZeroPivot`]).
+    /// regularization (a zero pivot then gives [`LinalgError::ZeroPivot`]).
     pub delta: f64,
     /// Dynamic regularization threshold (LDLᵀ only), see `delta`.
     pub epsilon: f64,
@@ -45,12 +45,12 @@ pub struct SolverOptions {
     /// Maximum number of refinement steps after the first solve.
     pub max_refinement_steps: usize,
     /// A solve whose final relative residual exceeds this (or `tolerance`,
-    /// if larger) is reported as [`SolveError::NotConverged`]; between
+    /// if larger) is reported as [`LinalgError::NotConverged`]; between
     /// `tolerance` and this it is returned (check [`SolveInfo::relative_residual`]).
     pub accept_residual: f64,
 }
 
-impl Default for SolverOptions {
+impl Default for FactorOptions {
     fn default() -> Self {
         Self {
             delta: 1e-8,
@@ -95,7 +95,7 @@ struct Core {
     kind: Kind,
     pattern: SymmetricPattern,
     signs: Vec<i8>,
-    options: SolverOptions,
+    options: FactorOptions,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     /// Unregularized matrix values (slot order) of the last factorization.
@@ -107,17 +107,17 @@ struct Core {
     solve_mem: Mutex<MemBuffer>,
 }
 
-fn faer_err(e: FaerError) -> SolveError {
+fn faer_err(e: FaerError) -> LinalgError {
     match e {
-        FaerError::OutOfMemory => SolveError::OutOfMemory,
-        FaerError::IndexOverflow => SolveError::OutOfMemory,
+        FaerError::OutOfMemory => LinalgError::OutOfMemory,
+        FaerError::IndexOverflow => LinalgError::OutOfMemory,
         #[allow(unreachable_patterns)]
-        _ => SolveError::OutOfMemory,
+        _ => LinalgError::OutOfMemory,
     }
 }
 
-fn alloc(req: StackReq) -> Result<MemBuffer, SolveError> {
-    MemBuffer::try_new(req).map_err(|_| SolveError::OutOfMemory)
+fn alloc(req: StackReq) -> Result<MemBuffer, LinalgError> {
+    MemBuffer::try_new(req).map_err(|_| LinalgError::OutOfMemory)
 }
 
 fn norm2(v: &[f64]) -> f64 {
@@ -130,7 +130,7 @@ fn norm2(v: &[f64]) -> f64 {
 }
 
 impl Core {
-    fn new(kind: Kind, pattern: &SymmetricPattern, signs: Vec<i8>) -> Result<Self, SolveError> {
+    fn new(kind: Kind, pattern: &SymmetricPattern, signs: Vec<i8>) -> Result<Self, LinalgError> {
         let n = pattern.dim();
         let sym = SymbolicSparseColMatRef::new_checked(
             n,
@@ -157,7 +157,7 @@ impl Core {
             kind,
             pattern: pattern.clone(),
             signs,
-            options: SolverOptions::default(),
+            options: FactorOptions::default(),
             symbolic,
             l_values,
             a_values: vec![0.0; pattern.nnz()],
@@ -167,11 +167,11 @@ impl Core {
         })
     }
 
-    fn factorize(&mut self, values: &[f64]) -> Result<(), SolveError> {
+    fn factorize(&mut self, values: &[f64]) -> Result<(), LinalgError> {
         self.factorized = false;
         self.pattern.check_len(values.len())?;
         if values.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NotFinite { what: "matrix values" });
+            return Err(LinalgError::NotFinite { what: "matrix values" });
         }
         self.a_values.copy_from_slice(values);
         let n = self.pattern.dim();
@@ -210,7 +210,7 @@ impl Core {
                         Spec::default(),
                     )
                     .map_err(|e| match e {
-                        LdltError::ZeroPivot { index } => SolveError::ZeroPivot { index },
+                        LdltError::ZeroPivot { index } => LinalgError::ZeroPivot { index },
                     })?;
             }
             Kind::Llt => {
@@ -226,13 +226,13 @@ impl Core {
                     )
                     .map_err(|e| match e {
                         LltError::NonPositivePivot { index } => {
-                            SolveError::NotPositiveDefinite { index }
+                            LinalgError::NotPositiveDefinite { index }
                         }
                     })?;
             }
         }
         if self.l_values.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NotFinite { what: "factor" });
+            return Err(LinalgError::NotFinite { what: "factor" });
         }
         self.factorized = true;
         Ok(())
@@ -240,7 +240,7 @@ impl Core {
 
     /// Plain solve of `k` column-major right-hand sides in place with the
     /// (regularized) factor.
-    fn raw_solve(&self, x: &mut [f64], k: usize) -> Result<(), SolveError> {
+    fn raw_solve(&self, x: &mut [f64], k: usize) -> Result<(), LinalgError> {
         let n = self.pattern.dim();
         let mut run = |buf: &mut MemBuffer| {
             let stack = MemStack::new(buf);
@@ -264,22 +264,22 @@ impl Core {
     }
 
     /// Solves `k` column-major right-hand sides with iterative refinement.
-    fn solve_many(&self, rhs: &[f64], k: usize, tolerance: f64) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
+    fn solve_many(&self, rhs: &[f64], k: usize, tolerance: f64) -> Result<(Vec<f64>, Vec<SolveInfo>), LinalgError> {
         if !self.factorized {
-            return Err(SolveError::NotFactorized);
+            return Err(LinalgError::NotFactorized);
         }
         let n = self.pattern.dim();
         if rhs.len() != n * k {
-            return Err(SolveError::DimensionMismatch {
+            return Err(LinalgError::DimensionMismatch {
                 what: "right-hand side",
                 expected: n * k,
                 found: rhs.len(),
             });
         }
         if rhs.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NotFinite { what: "right-hand side" });
+            return Err(LinalgError::NotFinite { what: "right-hand side" });
         }
-        let opts = SolverOptions { tolerance, ..self.options };
+        let opts = FactorOptions { tolerance, ..self.options };
         let mut x = rhs.to_vec();
         if n == 0 || k == 0 {
             return Ok((x, vec![SolveInfo { relative_residual: 0.0, refinement_steps: 0 }; k]));
@@ -305,7 +305,7 @@ impl Core {
                     continue;
                 }
                 if xj.iter().any(|v| !v.is_finite()) {
-                    return Err(SolveError::NotFinite { what: "solution" });
+                    return Err(LinalgError::NotFinite { what: "solution" });
                 }
                 self.pattern.mul_vec_unchecked(&self.a_values, xj, &mut kx);
                 let r = &mut residuals[active.len() * n..(active.len() + 1) * n];
@@ -349,7 +349,7 @@ impl Core {
         }
         for inf in &info {
             if inf.relative_residual.is_nan() || inf.relative_residual > opts.accept_residual.max(opts.tolerance) {
-                return Err(SolveError::NotConverged {
+                return Err(LinalgError::NotConverged {
                     relative_residual: inf.relative_residual,
                     steps: inf.refinement_steps,
                 });
@@ -384,7 +384,7 @@ pub enum Llt {}
 /// If the right-hand side is consistent the solve converges: the primal part
 /// is the unique solution and the multipliers are one valid choice (the
 /// multiplier null-space component is arbitrary).  If it is inconsistent the
-/// residual stalls and the solve returns [`SolveError::NotConverged`].
+/// residual stalls and the solve returns [`LinalgError::NotConverged`].
 pub type LdltSolver = SparseCholesky<Ldlt>;
 
 /// Sparse Cholesky (LLᵀ, no regularization) for symmetric positive definite
@@ -395,46 +395,46 @@ impl SparseCholesky<Ldlt> {
     /// Symbolic analysis for `pattern`. `signs[i]` is the expected pivot sign
     /// of row `i`: `+1` for primal rows, `−1` for constraint rows (`0`: only
     /// regularize pivots below `epsilon` in magnitude). Errors on bad lengths/signs.
-    pub fn new(pattern: &SymmetricPattern, signs: &[i8]) -> Result<Self, SolveError> {
+    pub fn new(pattern: &SymmetricPattern, signs: &[i8]) -> Result<Self, LinalgError> {
         if signs.len() != pattern.dim() {
-            return Err(SolveError::DimensionMismatch {
+            return Err(LinalgError::DimensionMismatch {
                 what: "signs",
                 expected: pattern.dim(),
                 found: signs.len(),
             });
         }
         if let Some((index, &sign)) = signs.iter().enumerate().find(|(_, s)| !(-1..=1).contains(*s)) {
-            return Err(SolveError::InvalidSign { index, sign });
+            return Err(LinalgError::InvalidSign { index, sign });
         }
         Ok(Self { core: Core::new(Kind::Ldlt, pattern, signs.to_vec())?, kind: PhantomData })
     }
 
-    /// Like [`Self::new`] with non-default [`SolverOptions`].
+    /// Like [`Self::new`] with non-default [`FactorOptions`].
     pub fn with_options(
         pattern: &SymmetricPattern,
         signs: &[i8],
-        options: SolverOptions,
-    ) -> Result<Self, SolveError> {
+        options: FactorOptions,
+    ) -> Result<Self, LinalgError> {
         let mut s = Self::new(pattern, signs)?;
         s.core.options = options;
         Ok(s)
     }
 
     /// Current options.
-    pub fn options(&self) -> SolverOptions {
+    pub fn options(&self) -> FactorOptions {
         self.core.options
     }
 }
 
 impl SparseCholesky<Llt> {
     /// Symbolic analysis (AMD ordering) for `pattern`.
-    pub fn new(pattern: &SymmetricPattern) -> Result<Self, SolveError> {
+    pub fn new(pattern: &SymmetricPattern) -> Result<Self, LinalgError> {
         let n = pattern.dim();
         Ok(Self { core: Core::new(Kind::Llt, pattern, vec![1; n])?, kind: PhantomData })
     }
 
     /// Builds the pattern from `triplets` (upper or full), analyses and factorizes.
-    pub fn from_triplets(n: usize, triplets: &[Triplet]) -> Result<Self, SolveError> {
+    pub fn from_triplets(n: usize, triplets: &[Triplet]) -> Result<Self, LinalgError> {
         let (pattern, values) = SymmetricPattern::with_values(n, triplets)?;
         let mut s = Self::new(&pattern)?;
         s.factorize(&values)?;
@@ -450,21 +450,21 @@ impl<K> SparseCholesky<K> {
 
     /// Replaces the options (takes effect at the next factorize/solve;
     /// `delta`/`epsilon` are unused for LLᵀ).
-    pub fn set_options(&mut self, options: SolverOptions) {
+    pub fn set_options(&mut self, options: FactorOptions) {
         self.core.options = options;
     }
 
     /// Numeric factorization of the matrix with upper-triangle `values` in
     /// slot order (length `pattern.nnz()`); reuses the symbolic analysis.
-    /// LLᵀ gives [`SolveError::NotPositiveDefinite`] if a pivot is ≤ 0 (a
+    /// LLᵀ gives [`LinalgError::NotPositiveDefinite`] if a pivot is ≤ 0 (a
     /// singular PSD matrix may instead pass with a tiny pivot and then fail to
     /// converge in [`Self::solve`]).
-    pub fn factorize(&mut self, values: &[f64]) -> Result<(), SolveError> {
+    pub fn factorize(&mut self, values: &[f64]) -> Result<(), LinalgError> {
         self.core.factorize(values)
     }
 
     /// [`Self::factorize`] from triplets (same convention as [`SymmetricPattern`]).
-    pub fn factorize_triplets(&mut self, triplets: &[Triplet]) -> Result<(), SolveError> {
+    pub fn factorize_triplets(&mut self, triplets: &[Triplet]) -> Result<(), LinalgError> {
         let v = self.core.pattern.values_from_triplets(triplets)?;
         self.core.factorize(&v)
     }
@@ -472,56 +472,56 @@ impl<K> SparseCholesky<K> {
     /// Solves with the (regularized) factor alone: no refinement and no
     /// residual, for callers that refine against a matrix of their own.
     /// Errors if not factorized, on a bad length or on non-finite values.
-    pub fn solve_unrefined(&self, rhs: &[f64]) -> Result<Vec<f64>, SolveError> {
+    pub fn solve_unrefined(&self, rhs: &[f64]) -> Result<Vec<f64>, LinalgError> {
         self.solve_unrefined_many(rhs, 1)
     }
 
     /// [`Self::solve_unrefined`] for `k` right-hand sides stored column-major
     /// in `rhs` (`n·k` values), in one blocked triangular solve.
-    pub fn solve_unrefined_many(&self, rhs: &[f64], k: usize) -> Result<Vec<f64>, SolveError> {
+    pub fn solve_unrefined_many(&self, rhs: &[f64], k: usize) -> Result<Vec<f64>, LinalgError> {
         let core = &self.core;
         if !core.factorized {
-            return Err(SolveError::NotFactorized);
+            return Err(LinalgError::NotFactorized);
         }
         let n = core.pattern.dim();
         if rhs.len() != n * k {
-            return Err(SolveError::DimensionMismatch { what: "right-hand side", expected: n * k, found: rhs.len() });
+            return Err(LinalgError::DimensionMismatch { what: "right-hand side", expected: n * k, found: rhs.len() });
         }
         if rhs.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NotFinite { what: "right-hand side" });
+            return Err(LinalgError::NotFinite { what: "right-hand side" });
         }
         let mut x = rhs.to_vec();
         if n > 0 && k > 0 {
             core.raw_solve(&mut x, k)?;
         }
         if x.iter().any(|v| !v.is_finite()) {
-            return Err(SolveError::NotFinite { what: "solution" });
+            return Err(LinalgError::NotFinite { what: "solution" });
         }
         Ok(x)
     }
 
     /// Solves `K x = rhs` (refinement until relative residual < `tolerance` or
     /// `max_refinement_steps`); errors if not factorized or not converged.
-    pub fn solve(&self, rhs: &[f64]) -> Result<Vec<f64>, SolveError> {
+    pub fn solve(&self, rhs: &[f64]) -> Result<Vec<f64>, LinalgError> {
         self.solve_with_info(rhs).map(|(x, _)| x)
     }
 
     /// [`Self::solve`] also returning the achieved residual and step count.
-    pub fn solve_with_info(&self, rhs: &[f64]) -> Result<(Vec<f64>, SolveInfo), SolveError> {
+    pub fn solve_with_info(&self, rhs: &[f64]) -> Result<(Vec<f64>, SolveInfo), LinalgError> {
         let (x, info) = self.core.solve_many(rhs, 1, self.core.options.tolerance)?;
         Ok((x, info[0]))
     }
 
     /// Solves for `k` right-hand sides stored column-major in `rhs`
     /// (`n·k` values) with one blocked triangular solve per refinement step.
-    pub fn solve_many(&self, rhs: &[f64], k: usize) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
+    pub fn solve_many(&self, rhs: &[f64], k: usize) -> Result<(Vec<f64>, Vec<SolveInfo>), LinalgError> {
         self.core.solve_many(rhs, k, self.core.options.tolerance)
     }
 
     /// [`Self::solve_many`] refined only to the relative residual
     /// `tolerance` (at least the options' `tolerance`), for solves that need
     /// less than the final accuracy.
-    pub fn solve_many_to(&self, rhs: &[f64], k: usize, tolerance: f64) -> Result<(Vec<f64>, Vec<SolveInfo>), SolveError> {
+    pub fn solve_many_to(&self, rhs: &[f64], k: usize, tolerance: f64) -> Result<(Vec<f64>, Vec<SolveInfo>), LinalgError> {
         self.core.solve_many(rhs, k, tolerance.max(self.core.options.tolerance))
     }
 }

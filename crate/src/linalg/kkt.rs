@@ -5,7 +5,7 @@
 
 use super::cholesky::{LdltSolver, SolveInfo, SparseSpd};
 use super::pattern::{SymmetricPattern, Triplet};
-use super::SolveError;
+use super::LinalgError;
 
 /// An assembled KKT matrix of size `n + m` (primal unknowns first, then one
 /// multiplier per constraint row) on a fixed pattern.
@@ -30,17 +30,17 @@ fn kkt_triplets(
     n: usize,
     c_triplets: &[Triplet],
     m: usize,
-) -> Result<Vec<Triplet>, SolveError> {
+) -> Result<Vec<Triplet>, LinalgError> {
     let mut t = Vec::with_capacity(a_triplets.len() + c_triplets.len());
     for &(r, c, v) in a_triplets {
         if r >= n || c >= n {
-            return Err(SolveError::IndexOutOfBounds { row: r, col: c, n });
+            return Err(LinalgError::IndexOutOfBounds { row: r, col: c, n });
         }
         t.push((r, c, v));
     }
     for &(r, c, v) in c_triplets {
         if r >= m || c >= n {
-            return Err(SolveError::IndexOutOfBounds { row: r, col: c, n: m.max(n) });
+            return Err(LinalgError::IndexOutOfBounds { row: r, col: c, n: m.max(n) });
         }
         // C[r, c] sits at K[n + r, c]; store its upper mirror K[c, n + r].
         t.push((c, n + r, v));
@@ -56,7 +56,7 @@ impl Kkt {
         n: usize,
         c_triplets: &[Triplet],
         m: usize,
-    ) -> Result<Self, SolveError> {
+    ) -> Result<Self, LinalgError> {
         let t = kkt_triplets(a_triplets, n, c_triplets, m)?;
         let (pattern, values) = SymmetricPattern::with_values(n + m, &t)?;
         let signs = (0..n + m).map(|i| if i < n { 1 } else { -1 }).collect();
@@ -64,30 +64,30 @@ impl Kkt {
     }
 
     /// Refills the values on the same pattern (entries must be a subset of the
-    /// assembled positions, else [`SolveError::NotInPattern`]).
-    pub fn refill(&mut self, a_triplets: &[Triplet], c_triplets: &[Triplet]) -> Result<(), SolveError> {
+    /// assembled positions, else [`LinalgError::NotInPattern`]).
+    pub fn refill(&mut self, a_triplets: &[Triplet], c_triplets: &[Triplet]) -> Result<(), LinalgError> {
         let t = kkt_triplets(a_triplets, self.n, c_triplets, self.m)?;
         self.pattern.fill_values(&t, &mut self.values)
     }
 
     /// A solver analysed for this pattern and factorized with the current values.
-    pub fn solver(&self) -> Result<LdltSolver, SolveError> {
+    pub fn solver(&self) -> Result<LdltSolver, LinalgError> {
         let mut s = LdltSolver::new(&self.pattern, &self.signs)?;
         s.factorize(&self.values)?;
         Ok(s)
     }
 
     /// Stacks `[b; d]` into one right-hand side of length `n + m`.
-    pub fn rhs(&self, rhs_primal: &[f64], rhs_constraint: &[f64]) -> Result<Vec<f64>, SolveError> {
+    pub fn rhs(&self, rhs_primal: &[f64], rhs_constraint: &[f64]) -> Result<Vec<f64>, LinalgError> {
         if rhs_primal.len() != self.n {
-            return Err(SolveError::DimensionMismatch {
+            return Err(LinalgError::DimensionMismatch {
                 what: "primal right-hand side",
                 expected: self.n,
                 found: rhs_primal.len(),
             });
         }
         if rhs_constraint.len() != self.m {
-            return Err(SolveError::DimensionMismatch {
+            return Err(LinalgError::DimensionMismatch {
                 what: "constraint right-hand side",
                 expected: self.m,
                 found: rhs_constraint.len(),
@@ -119,7 +119,7 @@ pub fn solve_kkt(
     m: usize,
     rhs_primal: &[f64],
     rhs_constraint: &[f64],
-) -> Result<KktSolution, SolveError> {
+) -> Result<KktSolution, LinalgError> {
     let kkt = Kkt::assemble(a_triplets, n, c_triplets, m)?;
     let rhs = kkt.rhs(rhs_primal, rhs_constraint)?;
     let solver = kkt.solver()?;
@@ -151,11 +151,11 @@ pub struct NullSpaceProjector {
 impl NullSpaceProjector {
     /// Factors `C Cᵀ` for the triplets `c` (`(row, unknown, value)`, rows
     /// `0..m`, unknowns `0..n`); fails when the factorization finds `C Cᵀ` singular.
-    pub fn new(c: &[Triplet], n: usize, m: usize) -> Result<Self, SolveError> {
+    pub fn new(c: &[Triplet], n: usize, m: usize) -> Result<Self, LinalgError> {
         let mut by_unknown: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
         for &(r, j, v) in c {
             if r >= m || j >= n {
-                return Err(SolveError::IndexOutOfBounds { row: r, col: j, n: m.max(n) });
+                return Err(LinalgError::IndexOutOfBounds { row: r, col: j, n: m.max(n) });
             }
             by_unknown[j].push((r, v));
         }

@@ -13,7 +13,7 @@
 //! * [`Kkt`] / [`solve_kkt`] — KKT assembly and a one-off solve.
 //!
 //! Everything runs sequentially (`Par::Seq`) and never reads the clock, so it
-//! works on `wasm32-unknown-unknown`.  Failures are [`SolveError`]s, not panics.
+//! works on `wasm32-unknown-unknown`.  Failures are [`LinalgError`]s, not panics.
 
 mod bordered;
 mod cholesky;
@@ -25,7 +25,7 @@ mod pattern;
 mod tests;
 
 pub use bordered::FixBorder;
-pub use cholesky::{Ldlt, LdltSolver, Llt, SolveInfo, SolverOptions, SparseCholesky, SparseSpd};
+pub use cholesky::{Ldlt, LdltSolver, Llt, SolveInfo, FactorOptions, SparseCholesky, SparseSpd};
 pub use krylov::{gmres, KrylovInfo};
 pub use kkt::{constraint_values, independent_rows, solve_kkt, Kkt, KktSolution, NullSpaceProjector};
 pub use pattern::{SymmetricPattern, Triplet, IGNORED_SLOT};
@@ -34,7 +34,7 @@ use std::fmt;
 
 /// Why a factorization or solve failed.
 #[derive(Clone, Debug, PartialEq)]
-pub enum SolveError {
+pub enum LinalgError {
     /// A slice had the wrong length.
     DimensionMismatch { what: &'static str, expected: usize, found: usize },
     /// A triplet index was outside the matrix.
@@ -61,34 +61,34 @@ pub enum SolveError {
     OutOfMemory,
 }
 
-impl fmt::Display for SolveError {
+impl fmt::Display for LinalgError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SolveError::DimensionMismatch { what, expected, found } => {
+            LinalgError::DimensionMismatch { what, expected, found } => {
                 write!(f, "{what}: expected length {expected}, found {found}")
             }
-            SolveError::IndexOutOfBounds { row, col, n } => {
+            LinalgError::IndexOutOfBounds { row, col, n } => {
                 write!(f, "entry ({row}, {col}) is outside the {n}×{n} matrix")
             }
-            SolveError::NotInPattern { row, col } => {
+            LinalgError::NotInPattern { row, col } => {
                 write!(f, "entry ({row}, {col}) is not in the analysed sparsity pattern")
             }
-            SolveError::InvalidSign { index, sign } => {
+            LinalgError::InvalidSign { index, sign } => {
                 write!(f, "pivot sign {sign} at row {index} is not -1, 0 or +1")
             }
-            SolveError::NotFinite { what } => write!(f, "{what} contains NaN or infinity"),
-            SolveError::ZeroPivot { index } => write!(f, "zero pivot at elimination step {index}"),
-            SolveError::NotPositiveDefinite { index } => {
+            LinalgError::NotFinite { what } => write!(f, "{what} contains NaN or infinity"),
+            LinalgError::ZeroPivot { index } => write!(f, "zero pivot at elimination step {index}"),
+            LinalgError::NotPositiveDefinite { index } => {
                 write!(f, "matrix is not positive definite (pivot at elimination step {index})")
             }
-            SolveError::NotConverged { relative_residual, steps } => write!(
+            LinalgError::NotConverged { relative_residual, steps } => write!(
                 f,
                 "solve did not converge: relative residual {relative_residual:.3e} after {steps} refinement steps"
             ),
-            SolveError::NotFactorized => write!(f, "solve called before a successful factorization"),
-            SolveError::OutOfMemory => write!(f, "out of memory in sparse factorization"),
+            LinalgError::NotFactorized => write!(f, "solve called before a successful factorization"),
+            LinalgError::OutOfMemory => write!(f, "out of memory in sparse factorization"),
         }
     }
 }
 
-impl std::error::Error for SolveError {}
+impl std::error::Error for LinalgError {}

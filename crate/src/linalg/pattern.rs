@@ -6,7 +6,7 @@
 //! entry) so that a factorization can reuse its symbolic analysis whenever
 //! only the values change.
 
-use super::SolveError;
+use super::LinalgError;
 
 /// Triplet convention used throughout [`crate::linalg`]: `(row, col, value)`.
 pub type Triplet = (usize, usize, f64);
@@ -33,7 +33,7 @@ impl SymmetricPattern {
     /// Builds the pattern of the `n × n` symmetric matrix whose entries are the
     /// positions of `triplets` (values are ignored; explicit zeros are kept).
     /// The diagonal is always included.  Errors on an index `>= n`.
-    pub fn from_triplets(n: usize, triplets: &[Triplet]) -> Result<Self, SolveError> {
+    pub fn from_triplets(n: usize, triplets: &[Triplet]) -> Result<Self, LinalgError> {
         Self::from_positions(n, triplets.iter().map(|&(r, c, _)| (r, c)))
     }
 
@@ -41,12 +41,12 @@ impl SymmetricPattern {
     pub fn from_positions(
         n: usize,
         positions: impl IntoIterator<Item = (usize, usize)>,
-    ) -> Result<Self, SolveError> {
+    ) -> Result<Self, LinalgError> {
         // Collect upper-triangular (row, col) pairs per column, plus the diagonal.
         let mut entries: Vec<(usize, usize)> = (0..n).map(|i| (i, i)).collect();
         for (r, c) in positions {
             if r >= n || c >= n {
-                return Err(SolveError::IndexOutOfBounds { row: r, col: c, n });
+                return Err(LinalgError::IndexOutOfBounds { row: r, col: c, n });
             }
             if r <= c {
                 entries.push((r, c));
@@ -67,7 +67,7 @@ impl SymmetricPattern {
     }
 
     /// Builds the pattern and the matching values (duplicates summed) in one go.
-    pub fn with_values(n: usize, triplets: &[Triplet]) -> Result<(Self, Vec<f64>), SolveError> {
+    pub fn with_values(n: usize, triplets: &[Triplet]) -> Result<(Self, Vec<f64>), LinalgError> {
         let pattern = Self::from_triplets(n, triplets)?;
         let values = pattern.values_from_triplets(triplets)?;
         Ok((pattern, values))
@@ -112,27 +112,27 @@ impl SymmetricPattern {
     /// For each triplet, the slot it is summed into ([`IGNORED_SLOT`] for a
     /// strictly-lower triplet).  Compute once, then refill values cheaply with
     /// [`Self::fill_values_with_slots`].  Errors if an entry is not in the pattern.
-    pub fn slot_map(&self, triplets: &[Triplet]) -> Result<Vec<usize>, SolveError> {
+    pub fn slot_map(&self, triplets: &[Triplet]) -> Result<Vec<usize>, LinalgError> {
         triplets
             .iter()
             .map(|&(r, c, _)| self.triplet_slot(r, c))
             .collect()
     }
 
-    fn triplet_slot(&self, r: usize, c: usize) -> Result<usize, SolveError> {
+    fn triplet_slot(&self, r: usize, c: usize) -> Result<usize, LinalgError> {
         if r >= self.n || c >= self.n {
-            return Err(SolveError::IndexOutOfBounds { row: r, col: c, n: self.n });
+            return Err(LinalgError::IndexOutOfBounds { row: r, col: c, n: self.n });
         }
         if r > c {
             return Ok(IGNORED_SLOT);
         }
-        self.slot(r, c).ok_or(SolveError::NotInPattern { row: r, col: c })
+        self.slot(r, c).ok_or(LinalgError::NotInPattern { row: r, col: c })
     }
 
     /// Values in slot order for `triplets` on this pattern (duplicates summed,
     /// strictly-lower ignored, absent entries zero).  Errors if a triplet lies
     /// outside the pattern.
-    pub fn values_from_triplets(&self, triplets: &[Triplet]) -> Result<Vec<f64>, SolveError> {
+    pub fn values_from_triplets(&self, triplets: &[Triplet]) -> Result<Vec<f64>, LinalgError> {
         let mut out = vec![0.0; self.nnz()];
         self.fill_values(triplets, &mut out)?;
         Ok(out)
@@ -140,7 +140,7 @@ impl SymmetricPattern {
 
     /// Overwrites `out` (length [`Self::nnz`]) with the values of `triplets`,
     /// like [`Self::values_from_triplets`] without allocating.
-    pub fn fill_values(&self, triplets: &[Triplet], out: &mut [f64]) -> Result<(), SolveError> {
+    pub fn fill_values(&self, triplets: &[Triplet], out: &mut [f64]) -> Result<(), LinalgError> {
         self.check_len(out.len())?;
         out.iter_mut().for_each(|v| *v = 0.0);
         for &(r, c, v) in triplets {
@@ -159,10 +159,10 @@ impl SymmetricPattern {
         slots: &[usize],
         values: &[f64],
         out: &mut [f64],
-    ) -> Result<(), SolveError> {
+    ) -> Result<(), LinalgError> {
         self.check_len(out.len())?;
         if slots.len() != values.len() {
-            return Err(SolveError::DimensionMismatch {
+            return Err(LinalgError::DimensionMismatch {
                 what: "slot map vs triplet values",
                 expected: slots.len(),
                 found: values.len(),
@@ -172,7 +172,7 @@ impl SymmetricPattern {
         for (&s, &v) in slots.iter().zip(values) {
             if s != IGNORED_SLOT {
                 if s >= out.len() {
-                    return Err(SolveError::DimensionMismatch {
+                    return Err(LinalgError::DimensionMismatch {
                         what: "slot index",
                         expected: out.len(),
                         found: s,
@@ -186,11 +186,11 @@ impl SymmetricPattern {
 
     /// `y = K x` for the symmetric matrix `K` with upper-triangle `values`
     /// (slot order).  Lengths must be `nnz`, `n`, `n`.
-    pub fn mul_vec(&self, values: &[f64], x: &[f64], y: &mut [f64]) -> Result<(), SolveError> {
+    pub fn mul_vec(&self, values: &[f64], x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
         self.check_len(values.len())?;
         for (what, len) in [("x", x.len()), ("y", y.len())] {
             if len != self.n {
-                return Err(SolveError::DimensionMismatch { what, expected: self.n, found: len });
+                return Err(LinalgError::DimensionMismatch { what, expected: self.n, found: len });
             }
         }
         self.mul_vec_unchecked(values, x, y);
@@ -222,9 +222,9 @@ impl SymmetricPattern {
         values.iter().fold(0.0f64, |m, v| m.max(v.abs()))
     }
 
-    pub(crate) fn check_len(&self, len: usize) -> Result<(), SolveError> {
+    pub(crate) fn check_len(&self, len: usize) -> Result<(), LinalgError> {
         if len != self.nnz() {
-            return Err(SolveError::DimensionMismatch {
+            return Err(LinalgError::DimensionMismatch {
                 what: "value slice (pattern nnz)",
                 expected: self.nnz(),
                 found: len,

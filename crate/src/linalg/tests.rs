@@ -87,11 +87,11 @@ fn pattern_sums_duplicates_ignores_lower_and_refills() {
     assert_eq!(out[p.slot(0, 1).unwrap()], 2.0);
     assert_eq!(
         p.values_from_triplets(&[(0, 2, 1.0)]),
-        Err(SolveError::NotInPattern { row: 0, col: 2 })
+        Err(LinalgError::NotInPattern { row: 0, col: 2 })
     );
     assert!(matches!(
         SymmetricPattern::from_triplets(3, &[(3, 0, 1.0)]),
-        Err(SolveError::IndexOutOfBounds { .. })
+        Err(LinalgError::IndexOutOfBounds { .. })
     ));
 }
 
@@ -154,7 +154,7 @@ fn refactorize_same_pattern_new_values() {
     let mut kkt = Kkt::assemble(&a, 5, &c, 2).unwrap();
     let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs).unwrap();
     let rhs = [1.0, 2.0, 3.0, 4.0, 5.0, 0.5, -0.5];
-    assert_eq!(solver.solve(&rhs), Err(SolveError::NotFactorized));
+    assert_eq!(solver.solve(&rhs), Err(LinalgError::NotFactorized));
     for round in 0..4 {
         let s = 1.0 + round as f64;
         let a2: Vec<Triplet> = a.iter().map(|&(i, j, v)| (i, j, v * s)).collect();
@@ -195,14 +195,14 @@ fn singular_cases_return_errors() {
     let kkt = Kkt::assemble(&a, 5, &c, 2).unwrap();
     // 1. No regularization: the zero constraint block gives a zero pivot
     //    (faer's LDLᵀ does not pivot), reported as an error, not a panic/NaN.
-    let opts = SolverOptions { delta: 0.0, ..SolverOptions::default() };
+    let opts = FactorOptions { delta: 0.0, ..FactorOptions::default() };
     let mut s = LdltSolver::with_options(&kkt.pattern, &kkt.signs, opts).unwrap();
     let r = s.factorize(&kkt.values);
     assert!(
-        matches!(r, Err(SolveError::ZeroPivot { .. })),
+        matches!(r, Err(LinalgError::ZeroPivot { .. })),
         "{r:?}"
     );
-    assert_eq!(s.solve(&[0.0; 7]), Err(SolveError::NotFactorized));
+    assert_eq!(s.solve(&[0.0; 7]), Err(LinalgError::NotFactorized));
 
     // 2. A variable with no entries at all and a nonzero right-hand side.
     let mut t = a.clone();
@@ -211,13 +211,13 @@ fn singular_cases_return_errors() {
     let mut s = LdltSolver::new(&p, &[1; 6]).unwrap();
     s.factorize(&v).unwrap(); // regularized: pivot replaced by +δ
     let r = s.solve(&[1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
-    assert!(matches!(r, Err(SolveError::NotConverged { .. })), "{r:?}");
+    assert!(matches!(r, Err(LinalgError::NotConverged { .. })), "{r:?}");
     // …and LLᵀ refuses it outright.
     let mut spd = SparseSpd::new(&p).unwrap();
-    assert!(matches!(spd.factorize(&v), Err(SolveError::NotPositiveDefinite { .. })));
+    assert!(matches!(spd.factorize(&v), Err(LinalgError::NotPositiveDefinite { .. })));
     assert!(matches!(
         SparseSpd::from_triplets(2, &[(0, 0, 1.0), (1, 1, -1.0)]),
-        Err(SolveError::NotPositiveDefinite { .. })
+        Err(LinalgError::NotPositiveDefinite { .. })
     ));
 
     // 3. Pure Neumann Laplacian (constants in the kernel): consistent rhs
@@ -233,21 +233,21 @@ fn singular_cases_return_errors() {
     let (_, info) = s.solve_with_info(&b).unwrap();
     assert!(info.relative_residual < 1e-10, "{info:?}");
     b[0] += 1.0;
-    assert!(matches!(s.solve(&b), Err(SolveError::NotConverged { .. })));
+    assert!(matches!(s.solve(&b), Err(LinalgError::NotConverged { .. })));
 
     // 4. Non-finite input and wrong lengths.
     let mut bad = kkt.values.clone();
     bad[0] = f64::NAN;
     let mut s = LdltSolver::new(&kkt.pattern, &kkt.signs).unwrap();
-    assert_eq!(s.factorize(&bad), Err(SolveError::NotFinite { what: "matrix values" }));
-    assert!(matches!(s.factorize(&bad[1..]), Err(SolveError::DimensionMismatch { .. })));
+    assert_eq!(s.factorize(&bad), Err(LinalgError::NotFinite { what: "matrix values" }));
+    assert!(matches!(s.factorize(&bad[1..]), Err(LinalgError::DimensionMismatch { .. })));
     s.factorize(&kkt.values).unwrap();
-    assert!(matches!(s.solve(&[1.0; 3]), Err(SolveError::DimensionMismatch { .. })));
+    assert!(matches!(s.solve(&[1.0; 3]), Err(LinalgError::DimensionMismatch { .. })));
     assert!(matches!(
         LdltSolver::new(&kkt.pattern, &[1, 1, 1, 1, 1, -1, 2]),
-        Err(SolveError::InvalidSign { index: 6, sign: 2 })
+        Err(LinalgError::InvalidSign { index: 6, sign: 2 })
     ));
-    assert!(matches!(solve_kkt(&a, 5, &c, 2, &[0.0; 4], &[0.0; 2]), Err(SolveError::DimensionMismatch { .. })));
+    assert!(matches!(solve_kkt(&a, 5, &c, 2, &[0.0; 4], &[0.0; 2]), Err(LinalgError::DimensionMismatch { .. })));
 }
 
 #[test]
@@ -288,7 +288,7 @@ fn redundant_constraint_rows() {
     // Inconsistent right-hand side (duplicate row asks for another value).
     let d_bad = vec![1.0, 0.5, -0.25, 2.0, 0.25];
     let r = solve_kkt(&a, n, &c, 5, &f, &d_bad);
-    assert!(matches!(r, Err(SolveError::NotConverged { .. })), "{r:?}");
+    assert!(matches!(r, Err(LinalgError::NotConverged { .. })), "{r:?}");
 }
 
 #[test]

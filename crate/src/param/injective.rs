@@ -26,7 +26,7 @@
 
 use super::element::Element;
 use super::ParamError;
-use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector, SolverOptions, Triplet};
+use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector, FactorOptions, Triplet};
 
 /// Iterations over which the energy decrease is averaged for the stop test:
 /// a step limited by one nearly degenerate triangle can gain little while the
@@ -243,7 +243,7 @@ impl<'a> Refiner<'a> {
         // factor is allocated (wasm memory never shrinks).
         drop(t);
         let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs)?;
-        solver.set_options(SolverOptions { delta: 1e-11, ..SolverOptions::default() });
+        solver.set_options(FactorOptions { delta: 1e-11, ..FactorOptions::default() });
         Ok(Refiner { elements, n, constraints, kkt, solver, slots, values, projector })
     }
 

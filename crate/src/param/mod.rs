@@ -35,7 +35,7 @@ mod tests;
 
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
-use crate::linalg::SolveError;
+use crate::linalg::LinalgError;
 use crate::mesh::TriMesh;
 use serde::Serialize;
 use std::fmt;
@@ -151,7 +151,7 @@ pub enum ParamError {
     /// A value became NaN or infinite.
     NotFinite { what: &'static str },
     /// The sparse KKT solve failed.
-    Solve(SolveError),
+    Solve(LinalgError),
 }
 
 impl fmt::Display for ParamError {
@@ -187,8 +187,8 @@ impl fmt::Display for ParamError {
 
 impl std::error::Error for ParamError {}
 
-impl From<SolveError> for ParamError {
-    fn from(e: SolveError) -> Self {
+impl From<LinalgError> for ParamError {
+    fn from(e: LinalgError) -> Self {
         ParamError::Solve(e)
     }
 }

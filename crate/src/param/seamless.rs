@@ -16,7 +16,7 @@ use super::metrics::{self, interior_cone_angles};
 use super::{ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
-use crate::linalg::{constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, SolveError, SolverOptions, Triplet};
+use crate::linalg::{constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, LinalgError, FactorOptions, Triplet};
 use crate::mesh::{TriMesh, UnionFind};
 
 /// Repair rounds tried without lowering the number of folds before giving up.
@@ -99,9 +99,9 @@ impl System {
         t
     }
 
-    /// The factorization ([`SolveError::NotFactorized`] once released).
+    /// The factorization ([`LinalgError::NotFactorized`] once released).
     fn solver(&self) -> Result<&LdltSolver, ParamError> {
-        self.solver.as_ref().ok_or(ParamError::Solve(SolveError::NotFactorized))
+        self.solver.as_ref().ok_or(ParamError::Solve(LinalgError::NotFactorized))
     }
 
     /// Global step: solves (23) for the target rotations `r` (rows in the
@@ -163,7 +163,7 @@ impl System {
     fn refactor(&mut self, weights: &[f64]) -> Result<(), ParamError> {
         let a = Self::a_triplets(&self.elements, weights);
         self.kkt.refill(&a, &self.constraints)?;
-        let solver = self.solver.as_mut().ok_or(ParamError::Solve(SolveError::NotFactorized))?;
+        let solver = self.solver.as_mut().ok_or(ParamError::Solve(LinalgError::NotFactorized))?;
         solver.factorize(&self.kkt.values)?;
         Ok(())
     }
@@ -307,7 +307,7 @@ pub fn solve(
         &kkt.signs,
         // Small regularization: the constraint pivots are exact zeros before
         // their primal neighbours are eliminated; a smaller delta refines faster here.
-        SolverOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..SolverOptions::default() },
+        FactorOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..FactorOptions::default() },
     )?;
     solver.factorize(&kkt.values)?;
     let projector = NullSpaceProjector::new(&constraints, n_unknowns, n_rows).ok();

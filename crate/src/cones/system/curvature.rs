@@ -13,7 +13,7 @@
 //! solves with the grounded cotangent Laplacian: a quarter of the KKT's
 //! dimension and definite. One factorization serves every trial.
 
-use crate::linalg::{LdltSolver, SolveError, SolverOptions, SymmetricPattern, Triplet};
+use crate::linalg::{LdltSolver, LinalgError, FactorOptions, SymmetricPattern, Triplet};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::FRAC_PI_2;
 
@@ -37,14 +37,14 @@ impl CurvatureSystem {
     /// triplets of `L` on the local vertices, `mass` is `M/A`, `path_rows`
     /// the path rows' `(row, column, value)` entries on `[phi | h~]`
     /// (columns `< nv` are `phi`, the next `nh` are `h~`; others ignored).
-    pub fn new(laplacian: &[Triplet], mass: Vec<f64>, path_rows: &[Triplet], nh: usize) -> Result<Self, SolveError> {
+    pub fn new(laplacian: &[Triplet], mass: Vec<f64>, path_rows: &[Triplet], nh: usize) -> Result<Self, LinalgError> {
         let nv = mass.len();
         let ng = nv.saturating_sub(1);
         let solver = if ng > 0 {
             let grounded: Vec<Triplet> = laplacian.iter().copied().filter(|&(r, c, _)| r < ng && c < ng).collect();
             let (pattern, values) = SymmetricPattern::with_values(ng, &grounded)?;
             let mut solver = LdltSolver::new(&pattern, &vec![1; ng])?;
-            solver.set_options(SolverOptions { max_refinement_steps: 50, ..SolverOptions::default() });
+            solver.set_options(FactorOptions { max_refinement_steps: 50, ..FactorOptions::default() });
             solver.factorize(&values)?;
             Some(solver)
         } else {
@@ -71,7 +71,7 @@ impl CurvatureSystem {
     /// Responses to `k` changes of the vertex right-hand side (`db`, `nv`
     /// values per column, column-major; the last vertex's entry is implied
     /// and ignored): `[d phi; d h~]` per column, `phi` of zero `M`-mean.
-    pub fn responses(&self, db: &[f64], k: usize, tolerance: f64) -> Result<Vec<f64>, SolveError> {
+    pub fn responses(&self, db: &[f64], k: usize, tolerance: f64) -> Result<Vec<f64>, LinalgError> {
         let nv = self.mass.len();
         let ng = nv.saturating_sub(1);
         let mut rhs = Vec::with_capacity(ng * k);
@@ -95,27 +95,27 @@ impl CurvatureSystem {
     }
 
     /// Fills the `h~` part of `column` from its `phi` part: `B_h dh = -B_phi dphi`.
-    fn h_response(&self, column: &mut [f64]) -> Result<(), SolveError> {
+    fn h_response(&self, column: &mut [f64]) -> Result<(), LinalgError> {
         let Some(lu) = &self.path_h else { return Ok(()) };
         let nv = self.mass.len();
         let rhs = DVector::from_iterator(
             self.path_phi.len(),
             self.path_phi.iter().map(|row| -row.iter().map(|&(v, w)| w * column[v]).sum::<f64>()),
         );
-        let dh = lu.solve(&rhs).ok_or(SolveError::NotFinite { what: "path rows' harmonic block" })?;
+        let dh = lu.solve(&rhs).ok_or(LinalgError::NotFinite { what: "path rows' harmonic block" })?;
         column[nv..].copy_from_slice(dh.as_slice());
         Ok(())
     }
 
     /// `h~ = B_h⁻¹ (shift - B_phi phi)`: the path rows solved for the
     /// harmonic part (`shift`: their right-hand side plus `(pi/2) p_l`).
-    pub fn harmonic(&self, phi: &[f64], shift: &[f64]) -> Result<Vec<f64>, SolveError> {
+    pub fn harmonic(&self, phi: &[f64], shift: &[f64]) -> Result<Vec<f64>, LinalgError> {
         let Some(lu) = &self.path_h else { return Ok(Vec::new()) };
         let rhs = DVector::from_iterator(
             self.path_phi.len(),
             self.path_phi.iter().zip(shift).map(|(row, s)| s - row.iter().map(|&(v, w)| w * phi[v]).sum::<f64>()),
         );
-        let h = lu.solve(&rhs).ok_or(SolveError::NotFinite { what: "path rows' harmonic block" })?;
+        let h = lu.solve(&rhs).ok_or(LinalgError::NotFinite { what: "path rows' harmonic block" })?;
         Ok(h.as_slice().to_vec())
     }
 
@@ -123,7 +123,7 @@ impl CurvatureSystem {
     /// `M`-mean) to moving cone index: `Phi` with a transfer of `a` quarter
     /// turns from `u` to `w` changing it by about `2 a (Phi[w] - Phi[u])`.
     /// `Phi = (pi/2) L_g⁻¹ (M phi / A)`, one solve.
-    pub fn move_potential(&self, phi: &[f64], tolerance: f64) -> Result<Vec<f64>, SolveError> {
+    pub fn move_potential(&self, phi: &[f64], tolerance: f64) -> Result<Vec<f64>, LinalgError> {
         let nv = self.mass.len();
         let ng = nv.saturating_sub(1);
         let r: Vec<f64> = phi[..ng].iter().zip(&self.mass).map(|(p, m)| p * m).collect();

@@ -11,7 +11,7 @@
 //! A transfer changes the right-hand sides of two vertex rows only (as in
 //! [`super::curvature`]), so its response is one column of a blocked solve.
 
-use crate::linalg::{Kkt, LdltSolver, SolveError, SolverOptions, Triplet};
+use crate::linalg::{Kkt, LdltSolver, LinalgError, FactorOptions, Triplet};
 use std::f64::consts::FRAC_PI_2;
 
 /// Proximal weight on the free ports' `p` (the component system's, so the
@@ -42,7 +42,7 @@ impl FreeCurvatureSystem {
         nq: usize,
         path_rows: &[Triplet],
         nh: usize,
-    ) -> Result<Self, SolveError> {
+    ) -> Result<Self, LinalgError> {
         let nv = mass.len();
         let n = nv + nh + nq;
         let mut a: Vec<Triplet> = objective.to_vec();
@@ -64,7 +64,7 @@ impl FreeCurvatureSystem {
         c.extend(path_rows.iter().map(|&(r, col, w)| (n_vertex_rows + r, col, w)));
         let kkt = Kkt::assemble(&a, n, &c, n_vertex_rows + nh)?;
         let mut solver = LdltSolver::new(&kkt.pattern, &kkt.signs)?;
-        solver.set_options(SolverOptions { max_refinement_steps: 50, ..SolverOptions::default() });
+        solver.set_options(FactorOptions { max_refinement_steps: 50, ..FactorOptions::default() });
         solver.factorize(&kkt.values)?;
         Ok(Self { kkt, solver, nv, nh, mass })
     }
@@ -72,7 +72,7 @@ impl FreeCurvatureSystem {
     /// Responses to `k` changes of the vertex right-hand side (`db`, `nv`
     /// values per column; the last vertex's entry is implied and ignored):
     /// `[d phi; d h~]` per column.
-    pub fn responses(&self, db: &[f64], k: usize, tolerance: f64) -> Result<Vec<f64>, SolveError> {
+    pub fn responses(&self, db: &[f64], k: usize, tolerance: f64) -> Result<Vec<f64>, LinalgError> {
         let (dim, n, nv) = (self.kkt.pattern.dim(), self.kkt.n, self.nv);
         let mut rhs = vec![0.0; dim * k];
         for (c, col) in db.chunks(nv).enumerate() {
@@ -86,7 +86,7 @@ impl FreeCurvatureSystem {
     /// `CurvatureSystem::move_potential`): with `y = K⁻¹ [M phi / A; 0]`,
     /// a change `Δb` of the vertex rows changes it by about `2 yᵀ Δb`, so
     /// `Phi = (pi/2) y` on the vertex rows (0 at the last vertex).
-    pub fn move_potential(&self, phi: &[f64], tolerance: f64) -> Result<Vec<f64>, SolveError> {
+    pub fn move_potential(&self, phi: &[f64], tolerance: f64) -> Result<Vec<f64>, LinalgError> {
         let (dim, n, nv) = (self.kkt.pattern.dim(), self.kkt.n, self.nv);
         let mut rhs = vec![0.0; dim];
         for i in 0..nv {

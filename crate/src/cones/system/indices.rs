@@ -120,7 +120,7 @@ impl ComponentSystem<'_> {
             let df = DMatrix::from_fn(nh, free.len(), |r, j| d[(r, free[j])]);
             let h = df.transpose() * &gram * &df;
             let rhs = -(df.transpose() * &gram * &c0);
-            let x = h.lu().solve(&rhs).ok_or(crate::linalg::SolveError::NotFinite { what: "path integer least squares" })?;
+            let x = h.lu().solve(&rhs).ok_or(crate::linalg::LinalgError::NotFinite { what: "path integer least squares" })?;
             let (j, _) = x.iter().enumerate().map(|(j, v)| (j, (v - v.round()).abs())).min_by(|a, b| a.1.total_cmp(&b.1)).expect("free is not empty");
             p[lg[free[j]]] = Some(x[j].round() as i64);
         }

@@ -158,7 +158,7 @@ impl ComponentSystem<'_> {
     /// small proximal block can defeat the unpivoted LDLᵀ: a teapot tube).
     fn free_trial<T>(
         &mut self,
-        reduced: impl FnOnce(&FreeCurvatureSystem) -> Result<T, crate::linalg::SolveError>,
+        reduced: impl FnOnce(&FreeCurvatureSystem) -> Result<T, crate::linalg::LinalgError>,
         kkt: impl FnOnce(&mut Self) -> Result<T, ConeError>,
     ) -> Result<T, ConeError> {
         if !self.free_curvature_failed {
