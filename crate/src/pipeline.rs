@@ -118,7 +118,17 @@ impl fmt::Display for SolveError {
     }
 }
 
-impl std::error::Error for SolveError {}
+impl std::error::Error for SolveError {
+    /// The stage's own error (cones, component results or parametrization).
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.cause {
+            SolveCause::Cones(e) => Some(e),
+            SolveCause::Components(e) => Some(e),
+            SolveCause::Param(e) => Some(e),
+            SolveCause::Folded { .. } => None,
+        }
+    }
+}
 
 /// The result: the mesh actually parametrized (the input, or the input with
 /// doubly constrained triangles split), its features, cones and UVs.
@@ -621,4 +631,23 @@ fn zero_angle_cones(placement: &ConePlacement) -> Vec<u32> {
     out.sort_unstable();
     out.dedup();
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::LinalgError;
+    use std::error::Error;
+
+    #[test]
+    fn errors_chain_down_to_the_linear_solve() {
+        let e = SolveError::unlocated(SolveCause::Param(ParamError::Solve(LinalgError::NotFactorized)));
+        let param = e.source().expect("the stage's error");
+        assert!(param.downcast_ref::<ParamError>().is_some());
+        let linalg = param.source().expect("the linear solve's error");
+        assert_eq!(linalg.downcast_ref::<LinalgError>(), Some(&LinalgError::NotFactorized));
+        assert!(linalg.source().is_none());
+        let folded = SolveError::unlocated(SolveCause::Folded { flipped: 1, wound: 0, refinements: 0, faces: vec![0] });
+        assert!(folded.source().is_none());
+    }
 }

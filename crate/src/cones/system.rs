@@ -173,7 +173,14 @@ impl std::fmt::Display for ConeError {
     }
 }
 
-impl std::error::Error for ConeError {}
+impl std::error::Error for ConeError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ConeError::Solve(e) => Some(e),
+            ConeError::InconsistentBoundary { .. } => None,
+        }
+    }
+}
 
 impl<'a> ComponentSystem<'a> {
     /// Builds and factorizes the system for the component containing face

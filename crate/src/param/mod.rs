@@ -185,7 +185,14 @@ impl fmt::Display for ParamError {
     }
 }
 
-impl std::error::Error for ParamError {}
+impl std::error::Error for ParamError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ParamError::Solve(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 impl From<LinalgError> for ParamError {
     fn from(e: LinalgError) -> Self {
