@@ -15,6 +15,9 @@ use common::shared_mesh as load;
 
 /// Solves `name` and checks the map; `max_flip_fraction` is the share of
 /// flipped triangles tolerated (0 except where a known shortfall is stated).
+/// The callers' distortion bounds are about 15 % above today's figures (in
+/// the comments, also in docs/STATUS.md): a regression of the placement or
+/// the map fails them.
 fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f64) {
     let input = load(name);
     let features = match sharp {
@@ -90,7 +93,7 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
 
 #[test]
 fn fandisk_with_sharp_features() {
-    run("fandisk.obj", Some(60.0), 0.23, 0.0);
+    run("fandisk.obj", Some(60.0), 0.185, 0.0); // .159
 }
 
 /// The bar for fandisk with features > 60° at alpha 0.01: at least
@@ -108,33 +111,33 @@ fn fandisk_with_sharp_features_has_85_percent_below_0_3() {
 /// cow.obj and teapot.obj have a pinch vertex each; it is split and they solve.
 #[test]
 fn meshes_with_a_pinch_vertex() {
-    run("cow.obj", None, 0.5, 0.0);
-    run("teapot.obj", None, 0.5, 0.0);
+    run("cow.obj", None, 0.12, 0.0); // .104
+    run("teapot.obj", None, 0.145, 0.0); // .125
 }
 
 #[test]
 fn spot() {
-    run("spot.obj", None, 0.5, 0.0);
+    run("spot.obj", None, 0.105, 0.0); // .091
 }
 
 #[test]
 fn woody() {
-    run("woody.obj", None, 0.5, 0.0);
+    run("woody.obj", None, 0.175, 0.0); // .150
 }
 
 #[test]
 fn alligator() {
-    run("alligator.obj", None, 0.5, 0.0);
+    run("alligator.obj", None, 0.135, 0.0); // .116
 }
 
 #[test]
 fn bff_punctured_torus() {
-    run("bff-punctured-torus.obj", None, 0.5, 0.0);
+    run("bff-punctured-torus.obj", None, 0.10, 0.0); // .088
 }
 
 #[test]
 fn bff_hemisphere() {
-    run("bff-hemisphere.obj", None, 0.5, 0.0);
+    run("bff-hemisphere.obj", None, 0.12, 0.0); // .104
 }
 
 /// A closed cylinder whose caps are triangle fans: with the rims as features

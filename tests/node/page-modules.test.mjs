@@ -1,0 +1,186 @@
+// Unit tests of the page's pure modules (web/src/topology.ts, features.ts,
+// solve-view.ts): each is bundled by esbuild to an ES module and imported, so
+// the tests run the page's code itself, without a browser.
+import { before, describe, it } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { pathToFileURL } from 'node:url';
+import * as esbuild from 'esbuild';
+import { root } from './wasm.mjs';
+
+const out = fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-page-modules-'));
+
+/** The module web/src/NAME.ts, bundled and imported. */
+async function load(name) {
+  const file = path.join(out, `${name}.mjs`);
+  await esbuild.build({ entryPoints: [path.join(root, 'web/src', `${name}.ts`)], bundle: true, format: 'esm', platform: 'neutral', outfile: file, logLevel: 'silent' });
+  return import(pathToFileURL(file).href);
+}
+
+/** An (n+1)×(n+1) grid of unit squares, each split along its diagonal: positions, triangles, edges (2 ids per edge). */
+function grid(n) {
+  const id = (i, j) => i * (n + 1) + j;
+  const positions = [];
+  for (let i = 0; i <= n; i++) for (let j = 0; j <= n; j++) positions.push(i, j, 0);
+  const tris = [];
+  for (let i = 0; i < n; i++) {
+    for (let j = 0; j < n; j++) tris.push(id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1));
+  }
+  const seen = new Map();
+  const edges = [];
+  for (let t = 0; t < tris.length; t += 3) {
+    for (let k = 0; k < 3; k++) {
+      const a = tris[t + k];
+      const b = tris[t + ((k + 1) % 3)];
+      const key = `${Math.min(a, b)},${Math.max(a, b)}`;
+      if (!seen.has(key)) { seen.set(key, edges.length / 2); edges.push(Math.min(a, b), Math.max(a, b)); }
+    }
+  }
+  return { positions: Float32Array.from(positions), indices: Uint32Array.from(tris), edges: Uint32Array.from(edges), vertexCount: (n + 1) ** 2 };
+}
+
+describe('topology.ts', () => {
+  let topo;
+  before(async () => { topo = await load('topology'); });
+
+  it('builds a CSR adjacency that lists every edge from both ends', () => {
+    const g = grid(3);
+    const adj = topo.buildAdjacency(g.edges, g.vertexCount);
+    const m = g.edges.length / 2;
+    assert.equal(adj.offsets[g.vertexCount], 2 * m);
+    for (let e = 0; e < m; e++) {
+      const [a, b] = [g.edges[2 * e], g.edges[2 * e + 1]];
+      assert.equal(topo.edgeBetween(adj, a, b), e);
+      assert.equal(topo.edgeBetween(adj, b, a), e);
+    }
+    assert.equal(topo.edgeBetween(adj, 0, g.vertexCount - 1), -1);
+  });
+
+  it('gives each face side its edge: interior edges twice, boundary edges once', () => {
+    const n = 3;
+    const g = grid(n);
+    const adj = topo.buildAdjacency(g.edges, g.vertexCount);
+    const fe = topo.faceEdges(g.indices, adj);
+    const uses = new Uint32Array(g.edges.length / 2);
+    for (const e of fe) uses[e]++;
+    const boundary = [...uses].filter((u) => u === 1).length;
+    assert.equal(boundary, 4 * n);
+    assert.ok([...uses].every((u) => u === 1 || u === 2));
+    // A side with no edge (a broken mesh) is marked, not guessed.
+    const bad = topo.faceEdges(Uint32Array.from([0, g.vertexCount - 1, 1]), adj);
+    assert.equal(bad[0], 0xffffffff);
+  });
+
+  it('finds the shortest path: the diagonal across the grid, none to another component', () => {
+    const n = 4;
+    const g = grid(n);
+    const adj = topo.buildAdjacency(g.edges, g.vertexCount);
+    const path = topo.shortestPath(adj, g.positions, 0, g.vertexCount - 1);
+    assert.equal(path.length, n, 'n diagonal edges');
+    let length = 0;
+    for (const e of path) {
+      const [a, b] = [g.edges[2 * e], g.edges[2 * e + 1]];
+      length += Math.hypot(...[0, 1, 2].map((c) => g.positions[3 * a + c] - g.positions[3 * b + c]));
+    }
+    assert.ok(Math.abs(length - n * Math.SQRT2) < 1e-5, `length ${length}`);
+    // Consecutive edges share a vertex: a path, in order from `from`.
+    let at = 0;
+    for (const e of path) {
+      const [a, b] = [g.edges[2 * e], g.edges[2 * e + 1]];
+      assert.ok(a === at || b === at);
+      at = a === at ? b : a;
+    }
+    assert.equal(at, g.vertexCount - 1);
+    assert.equal(topo.shortestPath(adj, g.positions, 5, 5).length, 0);
+    // A lone extra vertex cannot be reached.
+    const lone = topo.buildAdjacency(g.edges, g.vertexCount + 1);
+    const pos = Float32Array.from([...g.positions, 9, 9, 9]);
+    assert.equal(topo.shortestPath(lone, pos, 0, g.vertexCount), null);
+  });
+});
+
+describe('features.ts', () => {
+  let FeatureSet;
+  before(async () => { ({ FeatureSet } = await load('features')); });
+
+  it('toggles interior edges only, and undoes and redoes every change', () => {
+    const f = new FeatureSet(10, Uint32Array.from([0, 1]));
+    assert.equal(f.toggle(0), false, 'a boundary edge stays');
+    assert.equal(f.toggle(10), false, 'out of range');
+    assert.ok(f.toggle(5));
+    assert.ok(f.addAll([5, 6, 6, 7, 1]));
+    assert.deepEqual([...f.ids()], [5, 6, 7]);
+    assert.equal(f.count, 3);
+    assert.ok(f.undo());
+    assert.deepEqual([...f.ids()], [5]);
+    assert.ok(f.redo());
+    assert.deepEqual([...f.ids()], [5, 6, 7]);
+    assert.ok(f.toggle(6));
+    assert.equal(f.canRedo, false, 'a new change drops the redo stack');
+    assert.deepEqual([...f.ids()], [5, 7]);
+    assert.ok(f.clear());
+    assert.equal(f.count, 0);
+    assert.ok(f.undo());
+    assert.deepEqual([...f.ids()], [5, 7]);
+    assert.equal(f.addAll([5, 7]), false, 'nothing new: no change recorded');
+  });
+
+  it('replaces the previous sharp edges and keeps the ones marked by hand', () => {
+    const f = new FeatureSet(8, Uint32Array.from([0]));
+    f.toggle(2);
+    assert.ok(f.setSharp(Uint32Array.from([0, 3, 4])));
+    assert.deepEqual([...f.ids()], [2, 3, 4], 'boundary edge 0 is not a feature');
+    assert.ok(f.setSharp(Uint32Array.from([4, 5])));
+    assert.deepEqual([...f.ids()], [2, 4, 5]);
+    assert.ok(f.setSharp(null));
+    assert.deepEqual([...f.ids()], [2]);
+    assert.ok(f.undo());
+    assert.deepEqual([...f.ids()], [2, 4, 5]);
+  });
+});
+
+describe('solve-view.ts', () => {
+  let sv;
+  let topo;
+  before(async () => { [sv, topo] = await Promise.all([load('solve-view'), load('topology')]); });
+
+  it('colours and bins the distortion against its 99th percentile', () => {
+    const per = Float32Array.from({ length: 200 }, (_, i) => i / 100);
+    const d = sv.distortionView(per);
+    const sorted = [...per].sort((a, b) => a - b);
+    assert.equal(d.max, sorted[Math.floor(200 * 0.99)]);
+    assert.equal(d.histogram.length, sv.HISTOGRAM_BINS);
+    assert.equal(d.histogram.reduce((a, b) => a + b, 0), per.length, 'every face in one bin');
+    assert.equal(d.colors.length, 9 * per.length);
+    const rgb = [0, 0, 0];
+    sv.heatRgb(0, rgb, 0);
+    assert.deepEqual(rgb.map((x) => +x.toFixed(2)), [0.23, 0.45, 0.95]);
+    sv.heatRgb(7, rgb, 0); // clamped to 1
+    assert.deepEqual(rgb.map((x) => +x.toFixed(2)), [0.9, 0.2, 0.2]);
+  });
+
+  it('outlines the charts along seams and the boundary only', () => {
+    const g = grid(2);
+    const faceEdges = topo.faceEdges(g.indices, topo.buildAdjacency(g.edges, g.vertexCount));
+    {
+      const uv = new Float32Array(2 * g.indices.length);
+      for (let c = 0; c < g.indices.length; c++) { uv[2 * c] = g.positions[3 * g.indices[c]]; uv[2 * c + 1] = g.positions[3 * g.indices[c] + 1]; }
+      const m = g.edges.length / 2;
+      const uses = new Uint32Array(m);
+      for (const e of faceEdges) uses[e]++;
+      const boundary = Uint32Array.from([...uses.keys()].filter((e) => uses[e] === 1));
+      const seam = [...uses.keys()].find((e) => uses[e] === 2);
+      const seg = sv.cutSegments(uv, faceEdges, m, Uint32Array.from([seam]), boundary);
+      // One segment per boundary side, two for the seam (one per side of it).
+      assert.equal(seg.length / 6, boundary.length + 2);
+      for (let i = 0; i < seg.length; i += 3) assert.equal(seg[i + 2], Math.fround(0.005));
+      const layout = sv.layoutGeometry(uv);
+      assert.deepEqual(layout.layoutBounds, [0, 0, 2, 2]);
+      assert.ok(Math.abs(layout.layoutSphere[2] - Math.SQRT2) < 1e-6);
+      const checker = sv.checkerUv(uv);
+      assert.equal(Math.max(...checker) - Math.min(...checker), 2.5);
+    }
+  });
+});
