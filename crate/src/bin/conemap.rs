@@ -490,9 +490,10 @@ fn print_cones(file: &str, mesh: &TriMesh, features: &FeatureSet, options: &Cone
 }
 
 /// `solve`: import, cones, parametrization, export.
+/// `conemap solve`: read, place cones, parametrize, write the mesh with UVs
+/// (and the report when asked), print the summary.
 fn solve(args: &Args) -> Result<(), Failure> {
     use conemap::export::{self, ExportInput, ExportOptions, Format};
-    use conemap::io::{self, InputFile};
     use conemap::mesh::RawMesh;
     use conemap::pipeline::{self, SolveOptions};
 
@@ -503,7 +504,58 @@ fn solve(args: &Args) -> Result<(), Failure> {
     };
     let options = cone_options(args)?;
     // Fail before the long computation when the output cannot be created.
-    for path in [Some(out), args.value("--report")].into_iter().flatten() {
+    check_writable([Some(out), args.value("--report")].into_iter().flatten())?;
+
+    let mut clock = conemap::clock::Stopwatch::start();
+    let input_file = read_input(file)?;
+    let mut times = SolveTimes { import: clock.lap(), ..SolveTimes::default() };
+
+    let features = load_features(args, &input_file.mesh)?;
+    let solve_options = SolveOptions { cones: options, ..SolveOptions::default() };
+    let bar = ProgressLine::new(args);
+    let solution = pipeline::solve(&input_file.mesh, &features, &solve_options, &mut |p| match p {
+        pipeline::SolveProgress::Cones(p) => bar.cones(&p),
+        pipeline::SolveProgress::Param(p) => bar.param(&p),
+    });
+    bar.finish();
+    let solution = solution.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let alignment = solution.feature_alignment(&input_file.mesh, &features);
+    times.cones = solution.refine_seconds + solution.placement.timings.total;
+    times.param = clock.lap() - times.cones;
+
+    // Splitting doubly constrained triangles adds vertices: export the refined
+    // mesh then (its source attributes are not carried over).
+    let refined_raw;
+    let (raw_used, source_used) = if solution.splits > 0 {
+        refined_raw = RawMesh { positions: solution.mesh.positions().to_vec(), triangles: solution.mesh.faces().to_vec() };
+        (&refined_raw, None)
+    } else {
+        (&input_file.raw, input_file.source.as_ref())
+    };
+    let mut input = ExportInput::new(raw_used, &solution.mesh, &solution.param.uv).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    if let Some(source) = source_used {
+        input = input.with_gltf_source(source, &input_file.main, &input_file.others);
+    }
+    let stem = Path::new(file).file_stem().map(|s| s.to_string_lossy().into_owned());
+    let export_options = ExportOptions { checker: args.flag("--checker"), name: stem, ..ExportOptions::default() };
+    let data = export::export(&input, format, &export_options);
+    std::fs::write(out, &data).map_err(|e| Failure(format!("{out}: cannot write: {e}"), 1))?;
+    times.export = clock.lap();
+
+    let written = Written { path: out, format, input: &input, bytes: data.len() };
+    if let Some(path) = args.value("--report") {
+        let report = solve_report(&solution, &options, &alignment, &written, &times);
+        let text = serde_json::to_string_pretty(&report).map_err(|e| Failure(e.to_string(), 1))?;
+        std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
+    }
+    print_solution(file, &solution, &alignment, &written, &times);
+    Ok(())
+}
+
+/// Fails when a file cannot be created at one of `paths` (missing directory,
+/// or a directory in the way).
+fn check_writable<'a>(paths: impl IntoIterator<Item = &'a str>) -> Result<(), Failure> {
+    for path in paths {
         let parent = Path::new(path).parent().filter(|p| !p.as_os_str().is_empty());
         if let Some(dir) = parent {
             if !dir.is_dir() {
@@ -514,8 +566,23 @@ fn solve(args: &Args) -> Result<(), Failure> {
             return Err(Failure(format!("{path}: cannot write: is a directory"), 1));
         }
     }
+    Ok(())
+}
 
-    let mut clock = conemap::clock::Stopwatch::start();
+/// A mesh file read for `solve`: the file and its sibling buffers, the
+/// imported mesh with its glTF source (for a drop-in export), and the
+/// validated mesh.
+struct InputMesh {
+    main: conemap::io::InputFile,
+    others: Vec<conemap::io::InputFile>,
+    raw: conemap::mesh::RawMesh,
+    source: Option<conemap::io::gltf::GltfSource>,
+    mesh: TriMesh,
+}
+
+/// Reads and validates `file` (its first problem named when it cannot be parametrized).
+fn read_input(file: &str) -> Result<InputMesh, Failure> {
+    use conemap::io::{self, InputFile};
     let bytes = std::fs::read(file).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let name = Path::new(file).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let main = InputFile { name, bytes };
@@ -526,82 +593,83 @@ fn solve(args: &Args) -> Result<(), Failure> {
         let more = if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
         Failure(format!("{file}: cannot be parametrized: {first}{more}"), 1)
     })?;
-    let t_import = clock.lap();
+    Ok(InputMesh { main, others, raw, source, mesh })
+}
 
-    let features = load_features(args, &mesh)?;
-    let solve_options = SolveOptions { cones: options, ..SolveOptions::default() };
-    let bar = ProgressLine::new(args);
-    let solution = pipeline::solve(&mesh, &features, &solve_options, &mut |p| match p {
-        pipeline::SolveProgress::Cones(p) => bar.cones(&p),
-        pipeline::SolveProgress::Param(p) => bar.param(&p),
+/// Seconds per stage of `solve`.
+#[derive(Default)]
+struct SolveTimes {
+    import: f64,
+    cones: f64,
+    param: f64,
+    export: f64,
+}
+
+impl SolveTimes {
+    fn total(&self) -> f64 {
+        self.import + self.cones + self.param + self.export
+    }
+}
+
+/// What `solve` wrote.
+struct Written<'a> {
+    path: &'a str,
+    format: conemap::export::Format,
+    input: &'a conemap::export::ExportInput<'a>,
+    bytes: usize,
+}
+
+/// The `--report` JSON of a solve: the `cones --json` fields, the map's
+/// figures, the output written and the seconds per stage.
+fn solve_report(
+    solution: &conemap::pipeline::Solution,
+    options: &ConeOptions,
+    alignment: &conemap::pipeline::FeatureAlignment,
+    written: &Written,
+    times: &SolveTimes,
+) -> serde_json::Value {
+    let (mesh, placement, result) = (&*solution.mesh, &solution.placement, &solution.param);
+    let mut report = cones_json(mesh, &solution.features, options, placement);
+    report["inserted_vertices"] = serde_json::json!(solution.splits);
+    report["refinement"] = serde_json::json!(solution.refinement);
+    report["flip_refinements"] = serde_json::json!(solution.flip_refinements);
+    report["feature_alignment"] = serde_json::json!(alignment);
+    report["metrics"] = serde_json::json!(result.metrics);
+    report["seam_edges"] = serde_json::json!(result.seam_edges.len());
+    report["arap_iterations"] = serde_json::json!(result.arap_iterations);
+    report["flips_before_repair"] = serde_json::json!(result.flips_before_repair);
+    report["flips_fixed"] = serde_json::json!(result.flips_fixed);
+    report["repair_rounds"] = serde_json::json!(result.repair_rounds);
+    report["refine_iterations"] = serde_json::json!(result.refine_iterations);
+    report["untangle_iterations"] = serde_json::json!(result.untangle_iterations);
+    report["realized_cones"] = serde_json::json!(result.realized_cones.len());
+    let input = written.input;
+    report["output"] = serde_json::json!({
+        "path": written.path,
+        "format": format!("{:?}", written.format).to_ascii_lowercase(),
+        "vertices": input.output_vertex_count(),
+        "faces": mesh.n_faces(),
+        "bytes": written.bytes,
+        "uv_normalization": {"offset": input.uv_normalization().offset, "scale": input.uv_normalization().scale},
+        "notes": input.notes(),
     });
-    bar.finish();
-    let solution = solution.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
-    let (placement, result) = (&solution.placement, &solution.param);
-    let alignment = solution.feature_alignment(&mesh, &features);
-    let t_cones = solution.refine_seconds + placement.timings.total;
-    let t_param = clock.lap() - t_cones;
+    report["timings"] = serde_json::json!({
+        "import": times.import,
+        "cones": placement.timings,
+        "refine": solution.refine_seconds,
+        "cones_total": times.cones,
+        "param": result.timings,
+        "param_total": times.param,
+        "export": times.export,
+        "total": times.total(),
+    });
+    report
+}
 
-    // Splitting doubly constrained triangles adds vertices: export the refined
-    // mesh then (its source attributes are not carried over).
-    let refined_raw;
-    let (raw_used, source_used) = if solution.splits > 0 {
-        refined_raw = RawMesh { positions: solution.mesh.positions().to_vec(), triangles: solution.mesh.faces().to_vec() };
-        (&refined_raw, None)
-    } else {
-        (&raw, source.as_ref())
-    };
-    let mesh = &*solution.mesh;
-    let features = &*solution.features;
-    let mut input = ExportInput::new(raw_used, mesh, &result.uv).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
-    if let Some(source) = source_used {
-        input = input.with_gltf_source(source, &main, &others);
-    }
-    let stem = Path::new(file).file_stem().map(|s| s.to_string_lossy().into_owned());
-    let export_options = ExportOptions { checker: args.flag("--checker"), name: stem, ..ExportOptions::default() };
-    let data = export::export(&input, format, &export_options);
-    std::fs::write(out, &data).map_err(|e| Failure(format!("{out}: cannot write: {e}"), 1))?;
-    let t_export = clock.lap();
-    let total = t_import + t_cones + t_param + t_export;
-
-    if let Some(path) = args.value("--report") {
-        let mut report = cones_json(mesh, features, &options, placement);
-        report["inserted_vertices"] = serde_json::json!(solution.splits);
-        report["refinement"] = serde_json::json!(solution.refinement);
-        report["flip_refinements"] = serde_json::json!(solution.flip_refinements);
-        report["feature_alignment"] = serde_json::json!(alignment);
-        report["metrics"] = serde_json::json!(result.metrics);
-        report["seam_edges"] = serde_json::json!(result.seam_edges.len());
-        report["arap_iterations"] = serde_json::json!(result.arap_iterations);
-        report["flips_before_repair"] = serde_json::json!(result.flips_before_repair);
-        report["flips_fixed"] = serde_json::json!(result.flips_fixed);
-        report["repair_rounds"] = serde_json::json!(result.repair_rounds);
-        report["refine_iterations"] = serde_json::json!(result.refine_iterations);
-        report["untangle_iterations"] = serde_json::json!(result.untangle_iterations);
-        report["realized_cones"] = serde_json::json!(result.realized_cones.len());
-        report["output"] = serde_json::json!({
-            "path": out,
-            "format": format!("{format:?}").to_ascii_lowercase(),
-            "vertices": input.output_vertex_count(),
-            "faces": mesh.n_faces(),
-            "bytes": data.len(),
-            "uv_normalization": {"offset": input.uv_normalization().offset, "scale": input.uv_normalization().scale},
-            "notes": input.notes(),
-        });
-        report["timings"] = serde_json::json!({
-            "import": t_import,
-            "cones": placement.timings,
-            "refine": solution.refine_seconds,
-            "cones_total": t_cones,
-            "param": result.timings,
-            "param_total": t_param,
-            "export": t_export,
-            "total": total,
-        });
-        let text = serde_json::to_string_pretty(&report).map_err(|e| Failure(e.to_string(), 1))?;
-        std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
-    }
-
+/// The summary `solve` prints: mesh, cones, map quality, feature alignment,
+/// notes, the file written and the seconds per stage.
+fn print_solution(file: &str, solution: &conemap::pipeline::Solution, alignment: &conemap::pipeline::FeatureAlignment, written: &Written, times: &SolveTimes) {
+    let (mesh, features, placement, result) = (&*solution.mesh, &*solution.features, &solution.placement, &solution.param);
     let m = &result.metrics;
     println!("{file}: {} vertices, {} faces, {} feature edges", mesh.n_vertices(), mesh.n_faces(), features.len());
     println!(
@@ -637,16 +705,12 @@ fn solve(args: &Args) -> Result<(), Failure> {
             result.realized_cones.len()
         );
     }
-    for note in input.notes() {
+    for note in written.input.notes() {
         println!("  note: {note}");
     }
-    println!(
-        "  wrote {out}: {} vertices, {} faces",
-        input.output_vertex_count(),
-        mesh.n_faces()
-    );
+    println!("  wrote {}: {} vertices, {} faces", written.path, written.input.output_vertex_count(), mesh.n_faces());
+    let (t_import, t_cones, t_param, t_export, total) = (times.import, times.cones, times.param, times.export, times.total());
     println!(
         "  time: import {t_import:.3} s, cones {t_cones:.3} s, parametrization {t_param:.3} s, export {t_export:.3} s, total {total:.3} s"
     );
-    Ok(())
 }
