@@ -159,7 +159,7 @@ fn untangled_maps_report_the_cones_they_realize() {
     let solution = solve(&mesh, &features, &options, &mut |_| {}).expect("cow --sharp 70");
     let m = &solution.param.metrics;
     assert_eq!((m.flipped, m.wound_vertices), (0, 0));
-    assert!(solution.param.untangle_iterations > 0, "the repair alone leaves this map folded: untangling must have run");
+    assert!(solution.param.counts.untangle_iterations > 0, "the repair alone leaves this map folded: untangling must have run");
     assert!(!solution.param.realized_cones.is_empty(), "this map realizes some cones with another angle");
     let solved = &*solution.mesh;
     let on_feature = |v: u32| solved.outgoing(v).any(|h| solution.features.contains(solved.edge(h)));

@@ -39,7 +39,7 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
         m.boundary_corners,
         m.distortion,
         m.fraction_below_0_3,
-        p.flips_before_repair,
+        p.counts.flips_before_repair,
         m.flipped,
         m.seam_angle_residual,
         m.seam_length_residual,
@@ -48,7 +48,7 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
         t.field,
         t.poisson,
         t.arap,
-        p.arap_iterations,
+        p.counts.arap_iterations,
         t.repair,
         placement.timings.total,
     );

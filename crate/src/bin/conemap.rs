@@ -636,12 +636,11 @@ fn solve_report(
     report["feature_alignment"] = serde_json::json!(alignment);
     report["metrics"] = serde_json::json!(result.metrics);
     report["seam_edges"] = serde_json::json!(result.seam_edges.len());
-    report["arap_iterations"] = serde_json::json!(result.arap_iterations);
-    report["flips_before_repair"] = serde_json::json!(result.flips_before_repair);
-    report["flips_fixed"] = serde_json::json!(result.flips_fixed);
-    report["repair_rounds"] = serde_json::json!(result.repair_rounds);
-    report["refine_iterations"] = serde_json::json!(result.refine_iterations);
-    report["untangle_iterations"] = serde_json::json!(result.untangle_iterations);
+    if let serde_json::Value::Object(counts) = serde_json::json!(result.counts) {
+        for (key, value) in counts {
+            report[key.as_str()] = value;
+        }
+    }
     report["realized_cones"] = serde_json::json!(result.realized_cones.len());
     let input = written.input;
     report["output"] = serde_json::json!({
@@ -684,7 +683,7 @@ fn print_solution(file: &str, solution: &conemap::pipeline::Solution, alignment:
         m.distortion,
         m.max_distortion,
         m.flipped,
-        result.flips_fixed,
+        result.counts.flips_fixed,
         result.seam_edges.len()
     );
     if alignment.requested > 0 {

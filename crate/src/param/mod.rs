@@ -107,6 +107,19 @@ pub struct Parametrization {
     /// and every opened feature edge.
     pub seam_edges: Vec<u32>,
     pub metrics: Metrics,
+    /// Iterations and folds of the solve's stages.
+    #[serde(flatten)]
+    pub counts: ParamCounts,
+    /// Cones the map realizes with another index than `placement` gave
+    /// them, `(cut vertex, k)`: apply with [`ConePlacement::realize`]. The
+    /// metrics already count the realized cones.
+    pub realized_cones: Vec<(u32, i32)>,
+    pub timings: ParamTimings,
+}
+
+/// What the stages of the seamless solve ([`seamless::solve`]) ran and repaired.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ParamCounts {
     /// ARAP iterations run (after the Poisson solve).
     pub arap_iterations: usize,
     /// Flipped or degenerate triangles right after ARAP (before repair).
@@ -119,11 +132,6 @@ pub struct Parametrization {
     pub refine_iterations: usize,
     /// L-BFGS iterations of the untangling (0: the repair left no fold).
     pub untangle_iterations: usize,
-    /// Cones the map realizes with another index than `placement` gave
-    /// them, `(cut vertex, k)`: apply with [`ConePlacement::realize`]. The
-    /// metrics already count the realized cones.
-    pub realized_cones: Vec<(u32, i32)>,
-    pub timings: ParamTimings,
 }
 
 /// Why the parametrization failed.
@@ -244,12 +252,7 @@ pub fn parametrize(
         uv,
         seam_edges: cut.seam_edges.clone(),
         metrics,
-        arap_iterations: result.arap_iterations,
-        flips_before_repair: result.flips_before_repair,
-        flips_fixed: result.flips_fixed,
-        repair_rounds: result.repair_rounds,
-        refine_iterations: result.refine_iterations,
-        untangle_iterations: result.untangle_iterations,
+        counts: result.counts,
         realized_cones: result.realized,
         timings,
     })

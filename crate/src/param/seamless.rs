@@ -13,7 +13,7 @@ use super::injective::{RefineOptions, Refiner};
 use super::untangle::untangle;
 use super::element::{angle_sums, local_triangle, signed_uv_area, Element};
 use super::metrics::{self, interior_cone_angles};
-use super::{ParamError, ParamOptions, ParamProgress, ParamTimings};
+use super::{ParamCounts, ParamError, ParamOptions, ParamProgress, ParamTimings};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
 use crate::linalg::{constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, LinalgError, FactorOptions, Triplet};
@@ -45,15 +45,8 @@ const CONSTRAINT_TOLERANCE: f64 = 1e-14;
 #[derive(Clone, Debug)]
 pub struct SeamlessResult {
     pub uv: Vec<[f64; 2]>,
-    pub arap_iterations: usize,
-    pub flips_before_repair: usize,
-    pub flips_fixed: usize,
-    /// Fold-over repair rounds run.
-    pub repair_rounds: usize,
-    /// Iterations of the injective refinement ([`super::injective`]) kept.
-    pub refine_iterations: usize,
-    /// L-BFGS iterations of the untangling ([`super::untangle`]).
-    pub untangle_iterations: usize,
+    /// Iterations and folds of ARAP, the repair, the untangling and the refinement.
+    pub counts: ParamCounts,
     /// Cones the map realizes with another index than placed: `(cut
     /// vertex, k)` ([`ConePlacement::realize`]).
     pub realized: Vec<(u32, i32)>,
@@ -453,12 +446,14 @@ pub fn solve(
     timings.injective = clock.lap();
     Ok(SeamlessResult {
         uv: best_uv,
-        arap_iterations: iterations,
-        flips_before_repair: flips_before,
-        flips_fixed: flips_before - best_flips,
-        repair_rounds: round,
-        refine_iterations,
-        untangle_iterations,
+        counts: ParamCounts {
+            arap_iterations: iterations,
+            flips_before_repair: flips_before,
+            flips_fixed: flips_before - best_flips,
+            repair_rounds: round,
+            refine_iterations,
+            untangle_iterations,
+        },
         realized,
         energy,
     })
