@@ -9,15 +9,15 @@
 use std::time::Instant;
 
 use conemap::linalg::{Kkt, LdltSolver, SparseSpd, Triplet};
-use conemap::operators::{cotan_laplacian_triplets, vertex_areas};
+use conemap::TriMesh;
 
-fn grid(nx: usize, ny: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+fn grid(nx: usize, ny: usize) -> TriMesh {
     let h = 1.0 / nx.max(ny) as f64;
     let raw = conemap::mesh::shapes::grid(nx, ny, |u, v| {
         let (x, y) = (u * nx as f64 * h, v * ny as f64 * h);
         [x, y, 0.08 * (7.0 * x).sin() * (5.0 * y).cos()]
     });
-    (raw.positions, raw.triangles)
+    TriMesh::from_raw(&raw).expect("a bumpy grid is a valid mesh")
 }
 
 fn ms(t: Instant) -> f64 {
@@ -27,12 +27,12 @@ fn ms(t: Instant) -> f64 {
 fn main() {
     let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let (nx, ny) = (args.first().copied().unwrap_or(114), args.get(1).copied().unwrap_or(113));
-    let (pos, tris) = grid(nx, ny);
-    let n = pos.len();
+    let mesh = grid(nx, ny);
+    let n = mesh.n_vertices();
 
     // A = L + M / A_total  (α_smooth = 1).
-    let mut a: Vec<Triplet> = cotan_laplacian_triplets(&pos, &tris);
-    let m = vertex_areas(&pos, &tris);
+    let mut a: Vec<Triplet> = mesh.cotan_laplacian_triplets(0..mesh.n_faces() as u32);
+    let m = mesh.vertex_areas();
     let area: f64 = m.iter().sum();
     a.extend(m.iter().enumerate().map(|(i, mi)| (i, i, mi / area)));
 
@@ -114,7 +114,7 @@ fn main() {
 \"refactor_ms\":{t_refactor:.3},\"solve_ms\":{t_solve:.3},\"refinement_steps\":{},\
 \"relative_residual\":{:.3e},\"solve_many_ms_per_rhs\":{t_solve_many:.3},\"solve_many_worst_residual\":{worst:.3e},\
 \"spd_analyse_factor_ms\":{t_spd_factor:.3},\"spd_solve_ms\":{t_spd_solve:.3},\"spd_residual\":{:.3e}}}",
-        tris.len(),
+        mesh.n_faces(),
         n + mc,
         kkt.pattern.nnz(),
         info.refinement_steps,

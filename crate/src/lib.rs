@@ -3,8 +3,9 @@
 //! Global Parametrization".
 //!
 //! Data flows one way:
-//! file bytes → [`io`] (a [`RawMesh`]) → [`mesh`] (a validated [`TriMesh`])
-//! → discrete operators → cone placement → cut and field → parametrization → export.
+//! file bytes → [`io`] (a [`RawMesh`]) → [`mesh`] (a validated [`TriMesh`]
+//! and its geometry) → [`features`] → [`cones`] (cone placement) → [`param`]
+//! (cut, field, parametrization) → [`export`]; [`pipeline`] runs them in order.
 
 // `!(x > 0.0)` is how this crate rejects NaN along with non-positive values;
 // index loops read like the formulas they implement.
@@ -18,7 +19,6 @@ pub mod features;
 pub mod io;
 pub mod linalg;
 pub mod mesh;
-pub mod operators;
 pub mod pipeline;
 pub mod vec3;
 pub mod param;

@@ -31,11 +31,10 @@ fn check_exact(name: &str, mesh: &TriMesh, r: &ConePlacement) {
     // Interior cones of the cut mesh carry curvature k pi/2: check through phi.
     let cut = &r.cut.mesh;
     let mut lphi = vec![0.0; cut.n_vertices()];
-    for (i, j, w) in conemap::operators::cotan_laplacian_triplets(cut.positions(), cut.faces()) {
+    for (i, j, w) in cut.cotan_laplacian_triplets(0..cut.n_faces() as u32) {
         lphi[i] += w * r.phi[j];
     }
-    let is_b: Vec<bool> = (0..cut.n_vertices() as u32).map(|v| cut.is_boundary_vertex(v)).collect();
-    let defect = conemap::operators::angle_defects(cut.positions(), cut.faces(), &is_b);
+    let defect = cut.angle_defects();
     let mut worst: f64 = 0.0;
     for v in 0..cut.n_vertices() {
         worst = worst.max((lphi[v] + defect[v] - std::f64::consts::FRAC_PI_2 * r.k[v] as f64).abs());

@@ -9,7 +9,7 @@
 //!   `2g + m - 1` leftover edges in neither tree (tree-cotree): the homology
 //!   loops and boundary alignment paths `G_path`.
 
-use super::frames::Visit;
+use super::dual_path::Visit;
 use crate::mesh::{TriMesh, NONE};
 use std::collections::VecDeque;
 

@@ -9,10 +9,9 @@
 //! share one sparse Cholesky factorization.
 
 use super::dual_tree::{orientation, DualTree};
-use super::frames::Visit;
+use super::dual_path::Visit;
 use crate::linalg::{LinalgError, SparseSpd, Triplet};
 use crate::mesh::{TriMesh, NONE};
-use crate::operators;
 
 /// Harmonic basis forms of one component, stored as CR values per face
 /// halfedge: `u[i][h]` is the value of `u_i` at the midpoint of halfedge `h`
@@ -31,7 +30,7 @@ impl HarmonicBasis {
         if n_h == 0 {
             return Ok(HarmonicBasis { u: Vec::new(), gram: Vec::new() });
         }
-        let cot = operators::corner_cotangents(mesh.positions(), mesh.faces());
+        let cot = mesh.corner_cotangents();
         // Unknowns: one per interior edge of the component (value on the side
         // of edge_halfedges(e)[0]); on a closed component the first is pinned.
         let mut unknown = vec![NONE; mesh.n_edges()];
@@ -235,7 +234,7 @@ fn face_area(mesh: &TriMesh, f: u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cones::frames::vertex_cycle;
+    use crate::cones::dual_path::vertex_cycle;
     use crate::cones::test_meshes::{square_annulus, torus};
 
     fn check(mesh: &TriMesh) {

@@ -9,7 +9,7 @@
 //! ([`harmonic`]) → KKT system and rounding ([`system`]) → cone moves.
 
 pub mod dual_tree;
-pub mod frames;
+pub mod dual_path;
 pub mod harmonic;
 pub mod problem;
 pub mod system;

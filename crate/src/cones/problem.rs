@@ -5,7 +5,7 @@
 //! different threads or in different wasm instances (its result serializes),
 //! and [`ConeProblem::assemble`] joins the results into a [`ConePlacement`].
 
-use super::frames::{Frames, Visit};
+use super::dual_path::{segment_phi_coefficients, Visit};
 use super::system::{ComponentSystem, Weights};
 use super::{original_cones, BoundaryMode, ComponentFigures, ConeError, ConeOptions, ConePlacement, ConeTimings, ConeProgress};
 use crate::clock::Stopwatch;
@@ -15,11 +15,10 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// Everything the components' placements share: the mesh cut open along the
-/// features, face frames, boundary turning integers and the options.
+/// features (with its geometry), boundary turning integers and the options.
 #[derive(Clone, Debug)]
 pub struct ConeProblem {
     cut: CutMesh,
-    frames: Frames,
     boundary_k: Vec<i32>,
     /// One face of every component.
     seeds: Vec<u32>,
@@ -116,7 +115,6 @@ impl ConeProblem {
             cut.free_original_boundary(mesh);
         }
         let cm = &cut.mesh;
-        let frames = Frames::new(cm);
         let boundary_k = boundary_turning(cm);
         let mut seeds = vec![u32::MAX; cm.n_components()];
         for (f, &c) in cm.face_components().iter().enumerate() {
@@ -124,7 +122,7 @@ impl ConeProblem {
                 seeds[c as usize] = f as u32;
             }
         }
-        ConeProblem { cut, frames, boundary_k, seeds, options: *options, cut_seconds: clock.lap() }
+        ConeProblem { cut, boundary_k, seeds, options: *options, cut_seconds: clock.lap() }
     }
 
     /// Number of components of the cut mesh.
@@ -153,10 +151,10 @@ impl ConeProblem {
     /// Algorithm 1, cone moves and the optional clean-ups.
     pub fn place_component(&self, c: usize, progress: &mut dyn FnMut(ConeProgress)) -> Result<ComponentPlacement, ConeError> {
         let mut clock = Stopwatch::start();
-        let (cm, frames, options) = (&self.cut.mesh, &self.frames, &self.options);
+        let (cm, options) = (&self.cut.mesh, &self.options);
         let weights = Weights { alpha_smooth: options.alpha_smooth, miq: options.miq };
         progress(ConeProgress::Topology { component: c, components: self.n_components() });
-        let mut sys = ComponentSystem::new(cm, frames, self.seeds[c], &self.boundary_k, &self.cut.free, weights)?;
+        let mut sys = ComponentSystem::new(cm, self.seeds[c], &self.boundary_k, &self.cut.free, weights)?;
         sys.rounding = options.rounding;
         let topology_seconds = clock.lap();
         let mut rounds = None;
@@ -188,7 +186,7 @@ impl ConeProblem {
             let tri = cm.faces()[f as usize];
             for i in 0..3 {
                 let visit = Visit { h_in: hs[i], h_out: hs[(i + 1) % 3] };
-                let coef = frames.segment_phi_coefficients(cm, visit);
+                let coef = segment_phi_coefficients(cm, visit);
                 let mut w: f64 = (0..3).map(|j| coef[j] * phi[sys.local(tri[j]) as usize]).sum();
                 for (j, hj) in h.iter().enumerate() {
                     w += hj * sys.basis.segment(j, visit);
@@ -196,7 +194,7 @@ impl ConeProblem {
                 omega.push(w);
             }
         }
-        let area: f64 = faces.iter().map(|&f| frames.area(f)).sum();
+        let area: f64 = faces.iter().map(|&f| cm.face_areas()[f as usize]).sum();
         let figures = ComponentFigures {
             euler_characteristic: cm.component_euler_characteristic(c),
             boundary_loops: cm.component_boundary_loops(c),
@@ -294,8 +292,7 @@ impl ConeProblem {
                         && cm.outgoing(a).find(|&h| cm.head(h) == b).is_some_and(|h| self.cut.free[cm.edge(h) as usize])
                 })
                 .collect();
-            let frames = Frames::new(mesh);
-            let mut lsys = ComponentSystem::new(mesh, &frames, 0, &boundary_k, &free, weights).ok()?;
+            let mut lsys = ComponentSystem::new(mesh, 0, &boundary_k, &free, weights).ok()?;
             lsys.rounding = options.rounding;
             match &k_sub {
                 None => {

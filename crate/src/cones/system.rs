@@ -17,12 +17,11 @@
 //! Only values change between rounds, so the symbolic analysis is done once.
 
 use super::dual_tree::{is_free_edge, DualTree};
-use super::frames::{vertex_cycle, Frames, Visit};
+use super::dual_path::{cycle_transport, segment_phi_coefficients, vertex_cycle, Visit};
 use super::harmonic::HarmonicBasis;
 use super::RoundingRule;
 use crate::linalg::{FixBorder, Kkt, LdltSolver, LinalgError, FactorOptions, Triplet};
 use crate::mesh::{TriMesh, NONE};
-use crate::vec3;
 use std::f64::consts::FRAC_PI_2;
 use std::f64::consts::PI;
 
@@ -189,7 +188,6 @@ impl<'a> ComponentSystem<'a> {
     /// (`free`, per mesh edge; empty: none free).
     pub fn new(
         mesh: &'a TriMesh,
-        frames: &Frames,
         seed: u32,
         boundary_k: &[i32],
         free: &[bool],
@@ -208,10 +206,10 @@ impl<'a> ComponentSystem<'a> {
         // Per-vertex geometry on the component.
         let mut angle_sum = vec![0.0; nv];
         let mut area = vec![0.0; nv];
-        let angles = crate::operators::corner_angles(mesh.positions(), mesh.faces());
+        let (angles, areas) = (mesh.corner_angles(), mesh.face_areas());
         for &f in &tree.faces {
             let tri = mesh.faces()[f as usize];
-            let a = frames.area(f);
+            let a = areas[f as usize];
             for k in 0..3 {
                 let i = local[tri[k] as usize] as usize;
                 angle_sum[i] += angles[f as usize][k];
@@ -235,7 +233,7 @@ impl<'a> ComponentSystem<'a> {
             .enumerate()
             .map(|(i, &v)| {
                 let cycle = vertex_cycle(mesh, v);
-                let transport = frames.cycle_transport(mesh, &cycle);
+                let transport = cycle_transport(mesh, &cycle);
                 let j = ((defect[i] - transport) / (2.0 * PI)).round() as i64;
                 let g = cycle_signs(mesh, &tree, &cycle);
                 let free = g.iter().any(|&(g, _)| continuous[g as usize]);
@@ -296,8 +294,7 @@ impl<'a> ComponentSystem<'a> {
         // L on the component's faces (in mesh order, as summed before).
         let mut component_faces = tree.faces.clone();
         component_faces.sort_unstable();
-        let triangles: Vec<[u32; 3]> = component_faces.iter().map(|&f| mesh.faces()[f as usize]).collect();
-        let l = crate::operators::cotan_laplacian_triplets(mesh.positions(), &triangles);
+        let l = mesh.cotan_laplacian_triplets(component_faces.iter().copied());
         let laplacian: Vec<Triplet> = l
             .iter()
             .map(|&(r, c, w)| (local[r] as usize, local[c] as usize, w))
@@ -345,7 +342,7 @@ impl<'a> ComponentSystem<'a> {
         for &e in &tree.leftovers {
             let cycle = tree.fundamental_cycle(mesh, e);
             for visit in &cycle {
-                let coef = frames.segment_phi_coefficients(mesh, *visit);
+                let coef = segment_phi_coefficients(mesh, *visit);
                 let tri = mesh.faces()[(visit.h_in / 3) as usize];
                 for k in 0..3 {
                     c.push((row, local[tri[k] as usize] as usize, coef[k]));
@@ -355,7 +352,7 @@ impl<'a> ComponentSystem<'a> {
                 c.push((row, h0 + j, basis.path_integral(j, &cycle) / h_scale));
             }
             c.push((row, p0 + tree.g_index[e as usize] as usize, -FRAC_PI_2));
-            rhs.push(-frames.cycle_transport(mesh, &cycle));
+            rhs.push(-cycle_transport(mesh, &cycle));
             row += 1;
         }
         let path_rows: Vec<Triplet> = c[path_start..].iter().map(|&(r, col, w)| (r - row_path, col, w)).collect();
@@ -772,7 +769,7 @@ impl<'a> ComponentSystem<'a> {
         for &f in &self.tree.faces {
             let tri = self.mesh.faces()[f as usize];
             let p = |k: usize| phi[self.local[tri[k] as usize] as usize];
-            let cot = face_cotangents(self.mesh, f);
+            let cot = self.mesh.corner_cotangents()[f as usize];
             for k in 0..3 {
                 // Edge opposite corner k, weight cot(angle k) / 2.
                 let (a, b) = (p((k + 1) % 3), p((k + 2) % 3));
@@ -823,18 +820,16 @@ impl<'a> ComponentSystem<'a> {
 /// the mesh's own boundary turning (for tests).
 #[cfg(test)]
 pub(crate) fn test_system(mesh: &TriMesh) -> ComponentSystem<'_> {
-    let frames = Frames::new(mesh);
     let boundary_k = crate::features::boundary_turning(mesh);
-    ComponentSystem::new(mesh, &frames, 0, &boundary_k, &[], Weights { alpha_smooth: 0.01, miq: false }).unwrap()
+    ComponentSystem::new(mesh, 0, &boundary_k, &[], Weights { alpha_smooth: 0.01, miq: false }).unwrap()
 }
 
 /// [`test_system`] with the whole boundary of `mesh` free.
 #[cfg(test)]
 pub(crate) fn test_system_free(mesh: &TriMesh) -> ComponentSystem<'_> {
-    let frames = Frames::new(mesh);
     let boundary_k = crate::features::boundary_turning(mesh);
     let free: Vec<bool> = (0..mesh.n_edges() as u32).map(|e| mesh.is_boundary_edge(e)).collect();
-    ComponentSystem::new(mesh, &frames, 0, &boundary_k, &free, Weights { alpha_smooth: 0.01, miq: false }).unwrap()
+    ComponentSystem::new(mesh, 0, &boundary_k, &free, Weights { alpha_smooth: 0.01, miq: false }).unwrap()
 }
 
 /// The `G` edges a cycle crosses, with the sign `+1` when the cycle crosses
@@ -865,12 +860,3 @@ fn cycle_signs(mesh: &TriMesh, tree: &DualTree, cycle: &[Visit]) -> Vec<(u32, i3
     out
 }
 
-fn face_cotangents(mesh: &TriMesh, f: u32) -> [f64; 3] {
-    let tri = mesh.faces()[f as usize];
-    let p = tri.map(|v| mesh.position(v));
-    [0, 1, 2].map(|k| {
-        let u = vec3::sub(p[(k + 1) % 3], p[k]);
-        let w = vec3::sub(p[(k + 2) % 3], p[k]);
-        vec3::dot(u, w) / vec3::norm(vec3::cross(u, w))
-    })
-}

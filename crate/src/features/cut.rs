@@ -124,7 +124,7 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
 /// the 90° bound leaves no corner to move, the pipeline refines
 /// ([`super::refine_for_features`], [`super::split_around`]).
 pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
-    let sums = crate::operators::angle_sums(mesh.positions(), mesh.faces());
+    let sums = mesh.angle_sums();
     let nv = mesh.n_vertices();
     let turning: Vec<f64> = (0..nv).map(|v| (PI - sums[v]) / FRAC_PI_2).collect();
     let mut k: Vec<i32> = (0..nv as u32)

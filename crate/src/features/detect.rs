@@ -5,7 +5,6 @@
 
 use super::FeatureSet;
 use crate::mesh::TriMesh;
-use crate::operators;
 use serde::Serialize;
 
 /// Smallest feature curve kept by [`detect_sharp`].
@@ -64,13 +63,10 @@ pub struct SharpStats {
 pub fn sharp_edges(mesh: &TriMesh, threshold_degrees: f64) -> FeatureSet {
     let threshold = threshold_degrees.to_radians();
     let mut set = FeatureSet::none(mesh);
-    let normals = operators::face_normals(mesh.positions(), mesh.faces());
+    let dihedral = mesh.dihedral_angles();
     for e in 0..mesh.n_edges() as u32 {
-        let [h, t] = mesh.edge_halfedges(e);
-        if let (Some(f), Some(g)) = (mesh.face(h), mesh.face(t)) {
-            let (a, b) = (normals[f as usize], normals[g as usize]);
-            let cos = crate::vec3::dot(a, b).clamp(-1.0, 1.0);
-            set.set(mesh, e, cos.acos() > threshold);
+        if !mesh.is_boundary_edge(e) {
+            set.set(mesh, e, dihedral[e as usize] > threshold);
         }
     }
     set

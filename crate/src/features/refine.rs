@@ -185,7 +185,7 @@ fn plan_enclosed(m: &TriMesh, f: &FeatureSet, plan: &mut Splits) {
     }
     // Largest face of each region that needs a vertex (faces keep their ids in the cut).
     let mut largest: Vec<Option<(f64, u32)>> = vec![None; nc];
-    let areas = crate::operators::face_areas(m.positions(), m.faces());
+    let areas = m.face_areas();
     for face in 0..m.n_faces() as u32 {
         let c = cm.face_components()[face as usize] as usize;
         if has_interior[c] || k_sum[c] == 4 * cm.component_euler_characteristic(c) {

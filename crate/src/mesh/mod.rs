@@ -1,11 +1,14 @@
-//! Triangle meshes: the raw soup from a file, welding, validation, and the
-//! validated manifold [`TriMesh`] with halfedge connectivity.
+//! Triangle meshes: the raw soup from a file, welding, validation, the
+//! validated manifold [`TriMesh`] with halfedge connectivity, and its
+//! geometry (angles, areas, frames, the cotangent Laplacian: `geometry`).
 //!
 //! Pipeline: [`RawMesh`] → [`weld()`] (connectivity from positions) →
 //! [`analyze()`] (figures and [`crate::Problem`]s, never fails) →
-//! [`TriMesh::from_raw`] (fails with the blocking problems).
+//! [`TriMesh::from_raw`] (fails with the blocking problems) → the geometry
+//! accessors on [`TriMesh`] (each computed once, on first use).
 
 mod decimate;
+mod geometry;
 mod raw;
 pub mod shapes;
 mod subdivide;
@@ -18,6 +21,7 @@ mod weld;
 mod tests;
 
 pub use decimate::{decimate_interior, Decimated};
+pub use geometry::{wrap_angle, FaceFrames};
 pub use raw::RawMesh;
 pub use subdivide::subdivide_midpoint;
 pub use trimesh::{Outgoing, TriMesh, NONE};

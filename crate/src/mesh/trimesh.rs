@@ -38,6 +38,8 @@ pub struct TriMesh {
     report: MeshReport,
     source_to_welded: Vec<u32>,
     welded_to_source: Vec<u32>,
+    /// Derived quantities, filled on first use (see [`super::geometry`]).
+    pub(super) geometry: super::geometry::GeometryCache,
 }
 
 impl TriMesh {
@@ -176,6 +178,7 @@ impl TriMesh {
             report,
             source_to_welded,
             welded_to_source,
+            geometry: Default::default(),
         })
     }
 

@@ -5,7 +5,7 @@
 //! piecewise-linear map, and UV areas and angles.
 //!
 //! Conventions: a face's frame has corner 0 at the origin and its first edge
-//! along x (as `cones::frames::Frames`); a Jacobian's rows are the gradients
+//! along x (as [`crate::mesh::FaceFrames`]); a Jacobian's rows are the gradients
 //! of u and v in that frame; UV triangles are counter-clockwise when the map
 //! preserves orientation.
 

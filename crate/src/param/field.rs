@@ -1,13 +1,12 @@
 //! Cross-field from the connection (Appendix B.1).
 //!
 //! `beta[h]` is the field angle at the midpoint of face halfedge `h`'s edge,
-//! in the frame of face `h / 3` (frames as `cones::frames::Frames`). Inside a
+//! in the frame of face `h / 3` (frames as [`crate::mesh::FaceFrames`]). Inside a
 //! face `beta_{f,b} = beta_{f,a} + omega(a -> b)` (eq. 22); across an edge
 //! `beta_{g,e} = beta_{f,e} + kappa + m_e pi/2` (eq. 21) with `m_e = 0` on
 //! the edges of a dual spanning tree of the cut mesh (Bommes et al. 2009).
 
 use super::ParamError;
-use crate::cones::frames::Frames;
 use crate::cones::ConePlacement;
 use crate::mesh::TriMesh;
 use std::collections::VecDeque;
@@ -64,7 +63,6 @@ impl CrossField {
 pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossField, ParamError> {
     let cm = &placement.cut.mesh;
     let omega = &placement.omega;
-    let frames = Frames::new(mesh);
     let nf = mesh.n_faces();
     let mut beta = vec![f64::NAN; 3 * nf];
     let mut visited = vec![false; nf];
@@ -89,7 +87,7 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
             continue;
         }
         // Aligned with the edge when it must be; any value where no edge is aligned.
-        beta[s as usize] = if aligned(s) { frames.halfedge_angle(mesh, s) } else { 0.0 };
+        beta[s as usize] = if aligned(s) { mesh.halfedge_angle(s) } else { 0.0 };
         visited[f] = true;
         roots.push(f as u32);
         queue.push_back(s);
@@ -111,7 +109,7 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
                     visited[g] = true;
                     tree_edge[cm.edge(h) as usize] = true;
                     // eq. (21) with m = 0 on the dual tree.
-                    beta[t as usize] = beta[h as usize] + frames.kappa(mesh, h);
+                    beta[t as usize] = beta[h as usize] + mesh.kappa(h);
                     queue.push_back(t);
                 }
             }
@@ -129,7 +127,7 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
             continue;
         }
         // eq. (21): m_e = (beta_g - beta_f - kappa) / (pi/2).
-        let m = (beta[t as usize] - beta[h as usize] - frames.kappa(mesh, h)) / FRAC_PI_2;
+        let m = (beta[t as usize] - beta[h as usize] - mesh.kappa(h)) / FRAC_PI_2;
         let d = (m - m.round()).abs();
         residual = residual.max(d);
         if d > INTEGER_TOLERANCE || !m.is_finite() {
@@ -142,7 +140,7 @@ pub fn cross_field(mesh: &TriMesh, placement: &ConePlacement) -> Result<CrossFie
         if !aligned(h) {
             continue;
         }
-        let n = (beta[h as usize] - frames.halfedge_angle(mesh, h)) / FRAC_PI_2;
+        let n = (beta[h as usize] - mesh.halfedge_angle(h)) / FRAC_PI_2;
         let d = (n - n.round()).abs();
         residual = residual.max(d);
         if d > INTEGER_TOLERANCE || !n.is_finite() {

@@ -79,7 +79,7 @@ fn mismatched_placement_is_an_error() {
 /// Smallest ratio of UV area to 3D area over all faces, after scaling the
 /// UVs so the total areas match.
 fn min_area_ratio(mesh: &TriMesh, uv: &[[f64; 2]]) -> f64 {
-    let areas = crate::operators::face_areas(mesh.positions(), mesh.faces());
+    let areas = mesh.face_areas();
     let uv_areas: Vec<f64> = (0..mesh.n_faces())
         .map(|f| element::signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]))
         .collect();
