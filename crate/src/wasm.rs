@@ -3,15 +3,16 @@
 //! Errors cross as JS `Error`s carrying the library's one-line message; solve
 //! errors that name mesh elements also carry `location` ([`solve_error`]).
 
-use crate::cones::{self, BoundaryMode, ComponentPlacement, ConeOptions, ConePlacement, ConeProgress};
+use crate::cones::{self, BoundaryMode, ComponentFigures, ComponentPlacement, Cone, ConeOptions, ConePlacement, ConeProgress, ConeTimings};
 use crate::export::{self, ExportInput, ExportOptions};
-use crate::param::{self, ParamOptions, ParamProgress};
-use crate::pipeline::{ConeStage, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
-use crate::features::FeatureSet;
+use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
+use crate::pipeline::{ConeStage, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
+use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
 use crate::mesh::{self, MeshReport, RawMesh, TriMesh};
 use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, Uint8Array};
+use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
 /// Library version, for the page's about line.
@@ -180,9 +181,7 @@ impl MeshSession {
         let options = SolveOptions { cones, param: ParamOptions::default(), refine: self.refine };
         let placed = crate::pipeline::place_cones(mesh, &features, &options, &mut cone_progress(progress))
             .map_err(|e| JsError::new(&e.to_string()))?;
-        let out = cone_result(&placed.placement, features.len())?;
-        set(&out, "inserted_vertices", &(placed.refinement().0 as f64).into())?;
-        Ok(out.into())
+        to_js(&ConeResult::new(&placed.placement, features.len(), placed.refinement().0))
     }
 }
 
@@ -276,28 +275,12 @@ fn param_stage(p: &ParamProgress) -> (&'static str, usize, usize) {
 }
 
 impl MeshSession {
-    /// The result object of `solve` for the solution `sol` of `mesh`.
+    /// The result of `solve` for the solution `sol` of `mesh` (see [`SolveResult`]).
     fn solution_object(&self, mesh: &TriMesh, features: &FeatureSet, sol: &Solution) -> Result<JsValue, JsError> {
-        let out = cone_result(&sol.placement, sol.features.len())?;
-        let uv: Vec<f32> = sol.input_corner_uv(mesh).iter().flat_map(|p| p.map(|c| c as f32)).collect();
-        set(&out, "uv", &Float32Array::from(&uv[..]).into())?;
-        set(&out, "seam_edges", &Uint32Array::from(&sol.input_seam_edges(mesh)[..]).into())?;
-        let metrics = to_js(&sol.param.metrics)?;
-        let m: Object = metrics.clone().into();
-        set(&m, "below_0_2", &sol.param.metrics.fraction_below_0_2.into())?;
-        set(&m, "below_0_3", &sol.param.metrics.fraction_below_0_3.into())?;
-        let per_face: Vec<f32> = param::metrics::face_distortion(mesh, &sol.input_corner_uv(mesh), sol.param.metrics.scale)
-            .iter()
-            .map(|&d| d as f32)
-            .collect();
-        set(&m, "per_face_distortion", &Float32Array::from(&per_face[..]).into())?;
-        set(&out, "metrics", &metrics)?;
-        set(&out, "param_timings", &to_js(&sol.param.timings)?)?;
-        set(&out, "inserted_vertices", &(sol.splits as f64).into())?;
-        set(&out, "refinement", &to_js(&sol.refinement)?)?;
-        set(&out, "flip_refinements", &(sol.flip_refinements as f64).into())?;
-        set(&out, "realized_cones", &(sol.param.realized_cones.len() as f64).into())?;
-        set(&out, "feature_alignment", &to_js(&sol.feature_alignment(mesh, features))?)?;
+        let corner_uv = sol.input_corner_uv(mesh);
+        let uv: Vec<f32> = corner_uv.iter().flat_map(|p| p.map(|c| c as f32)).collect();
+        let per_face: Vec<f32> =
+            param::metrics::face_distortion(mesh, &corner_uv, sol.param.metrics.scale).iter().map(|&d| d as f32).collect();
         // Exports of the solved mesh (with any split edges), exactly.
         let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
         let mut input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &sol.param.uv)
@@ -306,9 +289,20 @@ impl MeshSession {
             input = input.with_gltf_source(source, &self.files[0], &self.files[1..]);
         }
         let glb = export::write_glb(&input, &ExportOptions::default());
-        set(&out, "glb", &Uint8Array::from(&glb[..]).into())?;
-        set(&out, "obj", &export::write_obj(&input, &ExportOptions::default()).into())?;
-        Ok(out.into())
+        let obj = export::write_obj(&input, &ExportOptions::default());
+        to_js(&SolveResult {
+            cones: ConeResult::new(&sol.placement, sol.features.len(), sol.splits),
+            uv: Float32Array::from(&uv[..]),
+            seam_edges: Uint32Array::from(&sol.input_seam_edges(mesh)[..]),
+            metrics: SolveMetrics { figures: &sol.param.metrics, per_face_distortion: Float32Array::from(&per_face[..]) },
+            param_timings: &sol.param.timings,
+            refinement: &sol.refinement,
+            flip_refinements: sol.flip_refinements,
+            realized_cones: sol.param.realized_cones.len(),
+            feature_alignment: sol.feature_alignment(mesh, features),
+            glb: Uint8Array::from(&glb[..]),
+            obj: Uint8Array::from(obj.as_bytes()),
+        })
     }
 }
 
@@ -381,23 +375,79 @@ fn cone_stage(p: &ConeProgress) -> (&'static str, usize, usize) {
     }
 }
 
-/// The cone-placement fields shared by `place_cones` and `solve`.
-fn cone_result(r: &ConePlacement, feature_edges: usize) -> Result<Object, JsError> {
-    let out = Object::new();
-    set(&out, "cones", &to_js(&r.cones)?)?;
-    set(&out, "boundary_corners", &to_js(&r.boundary_corners)?)?;
-    set(&out, "components", &to_js(&r.components)?)?;
-    set(&out, "rounds", &(r.rounds as f64).into())?;
-    set(&out, "energy", &r.energy.into())?;
-    set(&out, "phi_rms", &r.phi_rms.into())?;
-    set(&out, "timings", &to_js(&r.timings)?)?;
-    set(&out, "feature_edges", &(feature_edges as f64).into())?;
-    set(&out, "free_boundary", &r.cut.has_free_boundary().into())?;
-    Ok(out)
+/// What `place_cones` returns, and the first fields of [`SolveResult`];
+/// mirrored field for field by `ConeResult` in `web/src/protocol.ts`.
+#[derive(Serialize)]
+struct ConeResult<'a> {
+    cones: &'a [Cone],
+    boundary_corners: &'a [Cone],
+    components: &'a [ComponentFigures],
+    rounds: usize,
+    energy: f64,
+    phi_rms: f64,
+    timings: &'a ConeTimings,
+    /// Feature edges of the request.
+    feature_edges: usize,
+    free_boundary: bool,
+    /// Vertices the refinement inserted (around features and cones).
+    inserted_vertices: usize,
 }
 
-fn to_js<T: serde::Serialize>(value: &T) -> Result<JsValue, JsError> {
-    serde_wasm_bindgen::to_value(value).map_err(|e| JsError::new(&e.to_string()))
+impl<'a> ConeResult<'a> {
+    fn new(r: &'a ConePlacement, feature_edges: usize, inserted_vertices: usize) -> ConeResult<'a> {
+        ConeResult {
+            cones: &r.cones,
+            boundary_corners: &r.boundary_corners,
+            components: &r.components,
+            rounds: r.rounds,
+            energy: r.energy,
+            phi_rms: r.phi_rms,
+            timings: &r.timings,
+            feature_edges,
+            free_boundary: r.cut.has_free_boundary(),
+            inserted_vertices,
+        }
+    }
+}
+
+/// What `solve` / `solve_finish` return; mirrored field for field by
+/// `WasmSolveResult` in `web/src/protocol.ts`. Arrays cross as typed arrays.
+#[derive(Serialize)]
+struct SolveResult<'a> {
+    #[serde(flatten)]
+    cones: ConeResult<'a>,
+    /// Two per input face corner `3 f + k`.
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    uv: Float32Array,
+    /// Input edge ids.
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    seam_edges: Uint32Array,
+    metrics: SolveMetrics<'a>,
+    param_timings: &'a ParamTimings,
+    refinement: &'a RefineCounts,
+    flip_refinements: usize,
+    realized_cones: usize,
+    feature_alignment: FeatureAlignment,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    glb: Uint8Array,
+    /// The OBJ export, UTF-8.
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    obj: Uint8Array,
+}
+
+/// The map's [`Metrics`] and the distortion of every input face.
+#[derive(Serialize)]
+struct SolveMetrics<'a> {
+    #[serde(flatten)]
+    figures: &'a Metrics,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    per_face_distortion: Float32Array,
+}
+
+/// `value` as a plain JS object (maps too, as `#[serde(flatten)]` makes them).
+fn to_js<T: Serialize>(value: &T) -> Result<JsValue, JsError> {
+    let serializer = serde_wasm_bindgen::Serializer::new().serialize_maps_as_objects(true);
+    value.serialize(&serializer).map_err(|e| JsError::new(&e.to_string()))
 }
 
 fn input_files(files: &Array) -> Result<Vec<InputFile>, JsError> {

@@ -3,21 +3,7 @@
 // the tests run the page's code itself, without a browser.
 import { before, describe, it } from 'node:test';
 import assert from 'node:assert/strict';
-import fs from 'node:fs';
-import os from 'node:os';
-import path from 'node:path';
-import { pathToFileURL } from 'node:url';
-import * as esbuild from 'esbuild';
-import { root } from './wasm.mjs';
-
-const out = fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-page-modules-'));
-
-/** The module web/src/NAME.ts, bundled and imported. */
-async function load(name) {
-  const file = path.join(out, `${name}.mjs`);
-  await esbuild.build({ entryPoints: [path.join(root, 'web/src', `${name}.ts`)], bundle: true, format: 'esm', platform: 'neutral', outfile: file, logLevel: 'silent' });
-  return import(pathToFileURL(file).href);
-}
+import { loadPageModule as load } from './wasm.mjs';
 
 /** An (n+1)×(n+1) grid of unit squares, each split along its diagonal: positions, triangles, edges (2 ids per edge). */
 function grid(n) {

@@ -1,8 +1,10 @@
 // Shared helpers for the node tests: the nodejs wasm build and the test meshes.
 import fs from 'node:fs';
 import { createRequire } from 'node:module';
+import os from 'node:os';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+import * as esbuild from 'esbuild';
 
 export const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 export const sharedMeshes = path.resolve(root, '../shared/meshes');
@@ -14,6 +16,16 @@ const pkg = path.join(root, 'build/pkg-node/conemap.js');
 export function loadWasm() {
   if (!fs.existsSync(pkg)) throw new Error(`${pkg} missing: run \`npm run build\` first`);
   return createRequire(import.meta.url)(pkg);
+}
+
+let bundles = null;
+
+/** The page's module web/src/NAME.ts, bundled by esbuild and imported (its own code, without a browser). */
+export async function loadPageModule(name) {
+  bundles ??= fs.mkdtempSync(path.join(os.tmpdir(), 'conemap-page-modules-'));
+  const file = path.join(bundles, `${name}.mjs`);
+  await esbuild.build({ entryPoints: [path.join(root, 'web/src', `${name}.ts`)], bundle: true, format: 'esm', platform: 'neutral', outfile: file, logLevel: 'silent' });
+  return import(pathToFileURL(file).href);
 }
 
 /** Expected topology from ../shared/meshes/README.md. */

@@ -606,7 +606,7 @@ export class Editor {
       ['Features', fmtInt(r.feature_edges)],
       ['Cones', coneText],
       ['Boundary corners', fmtInt(r.boundary_corners.length)],
-      (r as { free_boundary?: boolean }).free_boundary
+      r.free_boundary
         ? ['Σk (cones)', `${sumConeK} (free boundary: its curvature takes the rest of 4χ)`]
         : ['Σk (cones + corners)', `${sumConeK + sumCornerK} = 4χ = ${4 * (report?.euler_characteristic ?? NaN)}`],
       ['Energy', fmt(r.energy, 4)],
@@ -614,34 +614,27 @@ export class Editor {
       ['Rounding rounds', fmtInt(r.rounds)],
     ];
     const metrics = r.metrics;
-    if (metrics) {
-      rows.push(
-        ['Distortion', fmt(metrics.distortion)],
-        ['Faces < 0.2 / < 0.3', `${fmt(metrics.below_0_2 * 100, 1)} % / ${fmt(metrics.below_0_3 * 100, 1)} %`],
-        ['Flipped faces', fmtInt(metrics.flipped)],
-        ['Seam length', fmt(metrics.seam_length)],
-        ['Seam residual (angle / length)', `${fmt(metrics.seam_angle_residual)} / ${fmt(metrics.seam_length_residual)}`],
-        ['Alignment residual', fmt(metrics.alignment_residual)],
-      );
-    }
+    rows.push(
+      ['Distortion', fmt(metrics.distortion)],
+      ['Faces < 0.2 / < 0.3', `${fmt(metrics.fraction_below_0_2 * 100, 1)} % / ${fmt(metrics.fraction_below_0_3 * 100, 1)} %`],
+      ['Flipped faces', fmtInt(metrics.flipped)],
+      ['Seam length', fmt(metrics.seam_length)],
+      ['Seam residual (angle / length)', `${fmt(metrics.seam_angle_residual)} / ${fmt(metrics.seam_length_residual)}`],
+      ['Alignment residual', fmt(metrics.alignment_residual)],
+    );
     // Components may be placed in parallel (a helper worker): their stage
     // times add up over components, the cone total is wall-clock.
     const summed = new Set(['topology', 'rounding', 'cone_moves']);
     for (const [k, v] of Object.entries(t)) {
-      if (typeof v !== 'number') continue;
       const label = k === 'total' ? 'cones total' : `${k.replace(/_/g, ' ')}${summed.has(k) ? ' (Σ components)' : ''}`;
       rows.push([`Time: ${label}`, `${(v * 1000).toFixed(0)} ms`]);
     }
-    const pt = (r as { param_timings?: Record<string, unknown> }).param_timings;
-    if (pt) {
-      for (const [k, v] of Object.entries(pt)) {
-        if (typeof v === 'number') rows.push([`Time: ${k.replace(/_/g, ' ')} (UV)`, `${(v * 1000).toFixed(0)} ms`]);
-      }
+    for (const [k, v] of Object.entries(r.param_timings)) {
+      rows.push([`Time: ${k.replace(/_/g, ' ')} (UV)`, `${(v * 1000).toFixed(0)} ms`]);
     }
-    const splits = (r as { inserted_vertices?: number }).inserted_vertices;
-    if (typeof splits === 'number' && splits > 0) rows.push(['Inserted vertices (refinement)', fmtInt(splits)]);
-    const alignment = (r as { feature_alignment?: { requested: number; aligned: number; unaligned: Array<{ edge: number; vertices: [number, number]; degrees: number }> } }).feature_alignment;
-    if (alignment && alignment.requested > 0) {
+    if (r.inserted_vertices > 0) rows.push(['Inserted vertices (refinement)', fmtInt(r.inserted_vertices)]);
+    const alignment = r.feature_alignment;
+    if (alignment.requested > 0) {
       const off = alignment.unaligned.slice(0, 5).map((u) => `(v${u.vertices[0]}, v${u.vertices[1]}) ${u.degrees.toFixed(1)}°`).join(', ');
       rows.push(['Features on isolines', `${fmtInt(alignment.aligned)} / ${fmtInt(alignment.requested)}${off ? ` — off: ${off}` : ''}`]);
     }
@@ -652,7 +645,7 @@ export class Editor {
     this.el.resultStats.replaceChildren(list);
     this.el.results.hidden = false;
 
-    const hasUv = Boolean(r.uv && r.uv.length === (m.data.indices.length / 3) * 6);
+    const hasUv = r.uv.length === (m.data.indices.length / 3) * 6;
     for (const radio of document.querySelectorAll<HTMLInputElement>('input[name=surface]')) {
       radio.disabled = radio.value !== 'shaded' && !hasUv;
       radio.parentElement!.title = radio.disabled ? 'parametrization not available in this build' : '';
@@ -663,7 +656,7 @@ export class Editor {
     this.el.obj.disabled = !r.obj;
     this.el.json.disabled = false;
     this.el.distortionLegend.hidden = true;
-    if (hasUv && r.uv) {
+    if (hasUv) {
       this.setProgress('building view');
       const view = r.view ?? this.buildView(m, r.uv, r);
       const distortion = view.distortion;
@@ -674,7 +667,7 @@ export class Editor {
       this.viewer.setUvSurface({ positions: view.cornerPositions, uv: view.checkerUv, colors });
       this.viewer.setSegments('seams', view.seamSegments, COLORS.seam, 2.5, 2);
       // Requested features the map left off an axis, drawn over everything.
-      this.viewer.setLines('unaligned', m.edges, alignment?.unaligned.map((u) => u.edge) ?? [], COLORS.unaligned, 5, 3);
+      this.viewer.setLines('unaligned', m.edges, alignment.unaligned.map((u) => u.edge), COLORS.unaligned, 5, 3);
       this.setSurface('checker');
       await this.viewer.prepare();
       if (!live()) return false;
@@ -707,7 +700,7 @@ export class Editor {
       featureEdges: r.feature_edges,
       shownCones: coneText,
       uv: hasUv,
-      seams: r.seam_edges?.length ?? 0,
+      seams: r.seam_edges.length,
       energy: r.energy,
       helperComponents: r.helperComponents ?? 0,
     };
@@ -750,7 +743,7 @@ export class Editor {
     for (const radio of document.querySelectorAll<HTMLInputElement>('input[name=surface]')) radio.checked = radio.value === mode;
     this.viewer.setSurfaceMode(mode);
     this.uvView.setColored(mode === 'distortion');
-    this.el.distortionLegend.hidden = mode !== 'distortion' || !this.result?.metrics?.per_face_distortion;
+    this.el.distortionLegend.hidden = mode !== 'distortion' || !this.result;
   }
 
   private baseName(): string {
@@ -763,7 +756,7 @@ export class Editor {
     const r = this.result;
     if (!m || !r) return null;
     const { uv: _uv, glb: _glb, obj: _obj, view: _view, seam_edges: seams, metrics, ...rest } = r;
-    const metricsOut = metrics ? { ...metrics, per_face_distortion: undefined } : undefined;
+    const metricsOut = { ...metrics, per_face_distortion: undefined };
     return {
       tool: 'conemap',
       file: m.label,
@@ -775,7 +768,7 @@ export class Editor {
         positions: Array.from(m.features?.ids() ?? [], (e) => [m.edges[2 * e]!, m.edges[2 * e + 1]!].map((v) => Array.from(m.data.positions.subarray(3 * v, 3 * v + 3)))),
         boundary_edges: m.features?.boundaryCount ?? 0,
       },
-      result: { ...rest, metrics: metricsOut, seam_edges: seams ? seams.length : undefined },
+      result: { ...rest, metrics: metricsOut, seam_edges: seams.length },
     };
   }
 

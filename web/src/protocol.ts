@@ -80,53 +80,137 @@ export interface Cone {
   position: [number, number, number];
 }
 
+/** Per-component figures (crate `cones::ComponentFigures`). */
 export interface ComponentResult {
   euler_characteristic: number;
   boundary_loops: number;
   genus: number;
   k_sum: number;
-  path_integers?: number[];
-  h?: number[];
+  path_integers: number[];
+  h: number[];
   rounds: number;
   moves: number;
+  merged_pairs: number;
+  cancelled_pairs: number;
+  spread_quarter_turns: number;
   residual: number;
-  [key: string]: unknown;
+  refinement_steps: number;
 }
 
+/** Seconds per cone stage (crate `cones::ConeTimings`). */
+export interface ConeTimings {
+  cut: number;
+  topology: number;
+  rounding: number;
+  cone_moves: number;
+  total: number;
+}
+
+/** Seconds per parametrization stage (crate `param::ParamTimings`). */
+export interface ParamTimings {
+  cut: number;
+  field: number;
+  poisson: number;
+  arap: number;
+  repair: number;
+  untangle: number;
+  injective: number;
+  metrics: number;
+}
+
+/** Splits made by the refinement, by reason (crate `features::RefineCounts`). */
+export interface RefineCounts {
+  lone_edges: number;
+  triply_constrained: number;
+  doubly_constrained: number;
+  enclosed_regions: number;
+  zero_angle_faces: number;
+  flipped_edges: number;
+}
+
+/** How the requested feature edges came out (crate `pipeline::FeatureAlignment`). */
+export interface FeatureAlignment {
+  requested: number;
+  aligned: number;
+  worst_radians: number;
+  unaligned: Array<{ edge: number; vertices: [number, number]; degrees: number }>;
+}
+
+/** The map's figures (crate `param::Metrics`) and the distortion of every input face. */
 export interface SolveMetrics {
   distortion: number;
-  below_0_2: number;
-  below_0_3: number;
+  scale: number;
+  fraction_below_0_2: number;
+  fraction_below_0_3: number;
+  max_distortion: number;
   flipped: number;
+  wound_vertices: number;
   seam_angle_residual: number;
   seam_length_residual: number;
   alignment_residual: number;
   cones: number;
+  boundary_corners: number;
+  seam_edges: number;
   seam_length: number;
-  per_face_distortion?: Float32Array;
-  [key: string]: unknown;
+  faces: number;
+  per_face_distortion: Float32Array;
 }
 
-/** The result of a solve: cones (as `place_cones` reports them), UVs, metrics and exports. */
-export interface SolveResult {
+/** What the wasm `place_cones` returns (crate `wasm::ConeResult`, field for field). */
+export interface ConeResult {
   cones: Cone[];
   boundary_corners: Cone[];
   components: ComponentResult[];
   rounds: number;
   energy: number;
   phi_rms: number;
-  timings: Record<string, number>;
+  timings: ConeTimings;
   feature_edges: number;
+  free_boundary: boolean;
+  inserted_vertices: number;
+}
+
+/** What the wasm `solve` / `solve_finish` return (crate `wasm::SolveResult`, field for field). */
+export interface WasmSolveResult extends ConeResult {
+  /** Two per input face corner 3f+k. */
+  uv: Float32Array;
+  /** Input edge ids. */
+  seam_edges: Uint32Array;
+  metrics: SolveMetrics;
+  param_timings: ParamTimings;
+  refinement: RefineCounts;
+  flip_refinements: number;
+  realized_cones: number;
+  feature_alignment: FeatureAlignment;
+  glb: Uint8Array;
+  /** The OBJ export, UTF-8. */
+  obj: Uint8Array;
+}
+
+// Every key of the wasm results, checked both ways by the compiler (a key
+// missing here, or one the type lacks, fails `tsc`); the node tests compare
+// them with the keys the wasm returns, so the two sides cannot drift apart.
+type Keys<T> = Record<keyof T, true>;
+export const CONE_RESULT_KEYS = {
+  cones: true, boundary_corners: true, components: true, rounds: true, energy: true, phi_rms: true, timings: true,
+  feature_edges: true, free_boundary: true, inserted_vertices: true,
+} as const satisfies Keys<ConeResult>;
+export const SOLVE_METRICS_KEYS = {
+  distortion: true, scale: true, fraction_below_0_2: true, fraction_below_0_3: true, max_distortion: true,
+  flipped: true, wound_vertices: true, seam_angle_residual: true, seam_length_residual: true,
+  alignment_residual: true, cones: true, boundary_corners: true, seam_edges: true, seam_length: true, faces: true,
+  per_face_distortion: true,
+} as const satisfies Keys<SolveMetrics>;
+export const WASM_SOLVE_RESULT_KEYS = {
+  ...CONE_RESULT_KEYS, uv: true, seam_edges: true, metrics: true, param_timings: true, refinement: true,
+  flip_refinements: true, realized_cones: true, feature_alignment: true, glb: true, obj: true,
+} as const satisfies Keys<WasmSolveResult>;
+
+/** A solve as the page receives it: the wasm result and what the worker adds. */
+export interface SolveResult extends WasmSolveResult {
   /** Milliseconds in the main worker from `solve-begin` to the end of `solve-finish`. */
   elapsed: number;
-  uv?: Float32Array;
-  seam_edges?: Uint32Array;
-  metrics?: SolveMetrics;
-  /** Exports, produced in the worker right after the solve. */
-  glb?: Uint8Array;
-  /** The OBJ export as UTF-8 bytes (encoded in the worker, so that it is transferred rather than copied). */
-  obj?: Uint8Array;
-  /** Display arrays built in the worker from `uv` (present with `uv`; see solve-view.ts). */
+  /** Display arrays built in the worker from `uv` (see solve-view.ts); absent when that failed. */
   view?: SolveView;
   /** Components whose cones a second (helper) worker placed; set by the page. */
   helperComponents?: number;

@@ -4,7 +4,7 @@
 // solves do not re-import it.
 import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { ErrorLocation, ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView } from './protocol';
+import type { ErrorLocation, ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView, WasmSolveResult } from './protocol';
 import { buildSolveView, viewBuffers } from './solve-view';
 import { buildAdjacency, faceEdges } from './topology';
 
@@ -34,7 +34,7 @@ interface Session {
   set_free_boundary(free: boolean): void;
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
   solve_add(bytes: Uint8Array): void;
-  solve_finish(progress: Progress): unknown;
+  solve_finish(progress: Progress): WasmSolveResult;
   free(): void;
 }
 let session: Session | null = null;
@@ -150,42 +150,13 @@ function solveStep(req: Extract<Request, { type: 'solve-begin' | 'solve-place' |
   }
 }
 
-/** The `SolveResult` of a wasm solve result `raw` (freed here), with its view; `t0`: when the solve began. */
-function solveAnswer(s: Session, raw0: unknown, t0: number): Answer {
-  const raw = raw0 as Record<string, unknown>;
-  // The result may be a plain object or a wasm-bindgen class (getters / methods on
-  // its prototype): read the known fields and any own ones, calling methods.
-  const keys = new Set([
-    'cones', 'boundary_corners', 'components', 'rounds', 'energy', 'phi_rms', 'timings', 'feature_edges',
-    'uv', 'seam_edges', 'metrics', 'glb', 'obj', ...Object.keys(raw),
-  ]);
-  const out: Record<string, unknown> = {};
-  for (const key of keys) {
-    if (key.startsWith('__') || key === 'free') continue;
-    let v: unknown;
-    try {
-      v = raw[key];
-      if (typeof v === 'function') v = (v as () => unknown).call(raw);
-    } catch (e) {
-      console.warn(`conemap: reading ${key} of the solve result failed: ${errorMessage(e)}`);
-      continue;
-    }
-    if (v !== undefined && typeof v !== 'function') out[key] = v;
-  }
-  if (typeof raw['free'] === 'function') (raw['free'] as () => void).call(raw);
-  if (Array.isArray(out['uv'])) out['uv'] = Float32Array.from(out['uv'] as number[]);
-  if (Array.isArray(out['seam_edges'])) out['seam_edges'] = Uint32Array.from(out['seam_edges'] as number[]);
-  if (typeof out['obj'] === 'string') out['obj'] = new TextEncoder().encode(out['obj']);
-  const metrics = out['metrics'] as Record<string, unknown> | undefined;
-  if (metrics && Array.isArray(metrics['per_face_distortion'])) {
-    metrics['per_face_distortion'] = Float32Array.from(metrics['per_face_distortion'] as number[]);
-  }
-  const solved = out as unknown as SolveResult;
+/** The `SolveResult` of the wasm result `solved`, with its view; `t0`: when the solve began. */
+function solveAnswer(s: Session, solved: WasmSolveResult, t0: number): Answer {
   const view = solveView(s, solved);
   const value: SolveResult = { ...solved, ...(view ? { view } : {}), elapsed: performance.now() - t0 };
   const transfer: Transferable[] = view ? viewBuffers(view) : [];
-  for (const v of [value.uv, value.seam_edges, value.glb, value.obj, value.metrics?.per_face_distortion]) {
-    if (v && ArrayBuffer.isView(v) && v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
+  for (const v of [value.uv, value.seam_edges, value.glb, value.obj, value.metrics.per_face_distortion]) {
+    if (v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
   }
   return { value, transfer };
 }
@@ -195,7 +166,7 @@ function solveAnswer(s: Session, raw0: unknown, t0: number): Answer {
  * page only uploads them; null when the result has no UVs for every corner or
  * building them fails (the page then builds them itself).
  */
-function solveView(s: Session, r: SolveResult): SolveView | null {
+function solveView(s: Session, r: WasmSolveResult): SolveView | null {
   try {
     const indices = s.indices();
     if (!(r.uv instanceof Float32Array) || r.uv.length !== indices.length * 2) return null;
@@ -204,7 +175,7 @@ function solveView(s: Session, r: SolveResult): SolveView | null {
     const fe = faceEdges(indices, buildAdjacency(edges, positions.length / 3));
     return buildSolveView({
       positions, indices, edges, boundary: s.boundary_edges(), faceEdges: fe, uv: r.uv,
-      seamEdges: r.seam_edges ?? null, perFaceDistortion: r.metrics?.per_face_distortion ?? null,
+      seamEdges: r.seam_edges, perFaceDistortion: r.metrics.per_face_distortion,
     });
   } catch (e) {
     console.warn(`conemap: building the solve view in the worker failed: ${errorMessage(e)}`);
