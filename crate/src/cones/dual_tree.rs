@@ -51,151 +51,41 @@ impl DualTree {
     /// one port of the first loop (an arbitrary gauge: every other cycle
     /// through the outer node crosses a free port).
     pub fn new(mesh: &TriMesh, seed: u32, free: &[bool]) -> DualTree {
-        let comp = mesh.face_components()[seed as usize];
-        let nf = mesh.n_faces();
-        let mut parent_he = vec![NONE; nf];
-        let mut depth = vec![NONE; nf];
-        let mut faces = Vec::new();
-        let mut queue = VecDeque::new();
-        let in_comp = |f: u32| mesh.face_components()[f as usize] == comp;
-        let is_free = |g: u32| is_free_edge(free, mesh.edge(g));
-
-        let loops: Vec<&Vec<u32>> = mesh
-            .boundary_loops()
-            .iter()
-            .filter(|lp| in_comp(mesh.twin(lp[0]) / 3))
-            .collect();
-        let has_boundary = !loops.is_empty();
-        // (loop, its root halfedge) for the loops the tree hangs from.
-        let mut rooted: Vec<(&Vec<u32>, u32)> =
-            loops.iter().filter_map(|lp| lp.iter().find(|&&g| !is_free(g)).map(|&g| (*lp, g))).collect();
-        if rooted.is_empty() && has_boundary {
-            rooted.push((loops[0], loops[0][0]));
-        }
-        if has_boundary {
-            for (lp, first) in rooted {
-                // Root port: the face halfedge of the loop's first aligned edge.
-                let root_h = mesh.twin(first);
-                let root = root_h / 3;
-                if depth[root as usize] == NONE {
-                    parent_he[root as usize] = root_h;
-                    depth[root as usize] = 1;
-                    faces.push(root);
-                    queue.push_back(root);
-                }
-                // Chain: the fans of the loop's vertices in order.
-                for &g in lp.iter() {
-                    let v = mesh.head(g);
-                    let mut prev_face = NONE;
-                    for h in mesh.outgoing(v) {
-                        let Some(f) = mesh.face(h) else { break };
-                        if prev_face != NONE && depth[f as usize] == NONE && depth[prev_face as usize] != NONE {
-                            parent_he[f as usize] = h; // entered across edge of h from the previous fan face
-                            depth[f as usize] = depth[prev_face as usize] + 1;
-                            faces.push(f);
-                            queue.push_back(f);
-                        }
-                        prev_face = f;
-                    }
-                }
-            }
-        } else {
-            depth[seed as usize] = 1;
-            faces.push(seed);
-            queue.push_back(seed);
-        }
-        // Breadth-first growth inward.
-        while let Some(f) = queue.pop_front() {
-            for h in mesh.face_halfedges(f) {
-                let t = mesh.twin(h);
-                if let Some(g) = mesh.face(t) {
-                    if depth[g as usize] == NONE {
-                        parent_he[g as usize] = t;
-                        depth[g as usize] = depth[f as usize] + 1;
-                        faces.push(g);
-                        queue.push_back(g);
-                    }
-                }
-            }
-        }
-
+        let t = DualSpanningTree::grow(mesh, seed, free);
         // Edges dual to T.
         let ne = mesh.n_edges();
         let mut in_t = vec![false; ne];
-        for &f in &faces {
-            if parent_he[f as usize] != NONE {
-                in_t[mesh.edge(parent_he[f as usize]) as usize] = true;
+        for &f in &t.faces {
+            if t.parent_he[f as usize] != NONE {
+                in_t[mesh.edge(t.parent_he[f as usize]) as usize] = true;
             }
         }
-        let mut vertices: Vec<u32> = faces.iter().flat_map(|&f| mesh.faces()[f as usize]).collect();
+        let mut vertices: Vec<u32> = t.faces.iter().flat_map(|&f| mesh.faces()[f as usize]).collect();
         vertices.sort_unstable();
         vertices.dedup();
-        let mut comp_edges: Vec<u32> = faces.iter().flat_map(|&f| mesh.face_halfedges(f).map(|h| mesh.edge(h))).collect();
+        let mut comp_edges: Vec<u32> = t.faces.iter().flat_map(|&f| mesh.face_halfedges(f).map(|h| mesh.edge(h))).collect();
         comp_edges.sort_unstable();
         comp_edges.dedup();
 
-        // T_p: breadth-first over primal edges not dual to T.
-        let nv = mesh.n_vertices();
-        let mut primal_parent_he = vec![NONE; nv];
-        let mut primal_depth = vec![NONE; nv];
-        let mut in_tp = vec![false; ne];
-        // Fewest non-free edges from the root (a 0-1 breadth-first search;
-        // without free edges a plain one): with a free boundary, T_p runs
-        // along the free edges wherever it can, so a free vertex's parent
-        // edge is a free port (no integer) except where a loop joins the rest.
-        let cost = |e: u32| u32::from(!is_free_edge(free, e));
-        let root_v = match comp_edges.iter().find(|&&e| is_free_edge(free, e)) {
-            Some(&e) => mesh.edge_vertices(e)[0],
-            None => vertices[0],
-        };
-        let mut dist = vec![u32::MAX; nv];
-        let mut done = vec![false; nv];
-        dist[root_v as usize] = 0;
-        primal_depth[root_v as usize] = 0;
-        let mut vq = VecDeque::from([root_v]);
-        while let Some(v) = vq.pop_front() {
-            if std::mem::replace(&mut done[v as usize], true) {
-                continue;
-            }
-            let ph = primal_parent_he[v as usize];
-            if ph != NONE {
-                in_tp[mesh.edge(ph) as usize] = true;
-                primal_depth[v as usize] = primal_depth[mesh.tail(ph) as usize] + 1;
-            }
-            for h in mesh.outgoing(v) {
-                let e = mesh.edge(h);
-                let w = mesh.head(h);
-                let d = dist[v as usize] + cost(e);
-                if !in_t[e as usize] && !done[w as usize] && d < dist[w as usize] {
-                    dist[w as usize] = d;
-                    primal_parent_he[w as usize] = h;
-                    if cost(e) == 0 {
-                        vq.push_front(w);
-                    } else {
-                        vq.push_back(w);
-                    }
-                }
-            }
-        }
-        debug_assert!(vertices.iter().all(|&v| primal_depth[v as usize] != NONE), "T_p spans the component");
+        let tp = PrimalSpanningTree::grow(mesh, free, &in_t, &comp_edges, &vertices);
 
         let g_edges: Vec<u32> = comp_edges.iter().copied().filter(|&e| !in_t[e as usize]).collect();
         let mut g_index = vec![NONE; ne];
         for (i, &e) in g_edges.iter().enumerate() {
             g_index[e as usize] = i as u32;
         }
-        let leftovers = g_edges.iter().copied().filter(|&e| !in_tp[e as usize]).collect();
+        let leftovers = g_edges.iter().copied().filter(|&e| !tp.in_tp[e as usize]).collect();
         DualTree {
-            faces,
+            faces: t.faces,
             vertices,
-            parent_he,
-            depth,
+            parent_he: t.parent_he,
+            depth: t.depth,
             g_edges,
             g_index,
-            primal_parent_he,
-            primal_depth,
+            primal_parent_he: tp.parent_he,
+            primal_depth: tp.depth,
             leftovers,
-            has_boundary,
+            has_boundary: t.has_boundary,
         }
     }
 
@@ -318,6 +208,153 @@ pub fn orientation(mesh: &TriMesh, h: u32) -> i32 {
         1
     } else {
         -1
+    }
+}
+
+
+/// `T` of [`DualTree`]: the faces of one component in the order they joined,
+/// with their parent halfedges and depths (per mesh face).
+struct DualSpanningTree {
+    faces: Vec<u32>,
+    parent_he: Vec<u32>,
+    depth: Vec<u32>,
+    has_boundary: bool,
+}
+
+impl DualSpanningTree {
+    /// Grows `T` for the component of face `seed` as [`DualTree::new`] says:
+    /// from the root ports along each rooted loop's chain of faces, then
+    /// breadth-first inward (from `seed` on a closed component).
+    fn grow(mesh: &TriMesh, seed: u32, free: &[bool]) -> DualSpanningTree {
+        let comp = mesh.face_components()[seed as usize];
+        let nf = mesh.n_faces();
+        let mut parent_he = vec![NONE; nf];
+        let mut depth = vec![NONE; nf];
+        let mut faces = Vec::new();
+        let mut queue = VecDeque::new();
+        let in_comp = |f: u32| mesh.face_components()[f as usize] == comp;
+        let is_free = |g: u32| is_free_edge(free, mesh.edge(g));
+
+        let loops: Vec<&Vec<u32>> = mesh
+            .boundary_loops()
+            .iter()
+            .filter(|lp| in_comp(mesh.twin(lp[0]) / 3))
+            .collect();
+        let has_boundary = !loops.is_empty();
+        // (loop, its root halfedge) for the loops the tree hangs from.
+        let mut rooted: Vec<(&Vec<u32>, u32)> =
+            loops.iter().filter_map(|lp| lp.iter().find(|&&g| !is_free(g)).map(|&g| (*lp, g))).collect();
+        if rooted.is_empty() && has_boundary {
+            rooted.push((loops[0], loops[0][0]));
+        }
+        if has_boundary {
+            for (lp, first) in rooted {
+                // Root port: the face halfedge of the loop's first aligned edge.
+                let root_h = mesh.twin(first);
+                let root = root_h / 3;
+                if depth[root as usize] == NONE {
+                    parent_he[root as usize] = root_h;
+                    depth[root as usize] = 1;
+                    faces.push(root);
+                    queue.push_back(root);
+                }
+                // Chain: the fans of the loop's vertices in order.
+                for &g in lp.iter() {
+                    let v = mesh.head(g);
+                    let mut prev_face = NONE;
+                    for h in mesh.outgoing(v) {
+                        let Some(f) = mesh.face(h) else { break };
+                        if prev_face != NONE && depth[f as usize] == NONE && depth[prev_face as usize] != NONE {
+                            parent_he[f as usize] = h; // entered across edge of h from the previous fan face
+                            depth[f as usize] = depth[prev_face as usize] + 1;
+                            faces.push(f);
+                            queue.push_back(f);
+                        }
+                        prev_face = f;
+                    }
+                }
+            }
+        } else {
+            depth[seed as usize] = 1;
+            faces.push(seed);
+            queue.push_back(seed);
+        }
+        // Breadth-first growth inward.
+        while let Some(f) = queue.pop_front() {
+            for h in mesh.face_halfedges(f) {
+                let t = mesh.twin(h);
+                if let Some(g) = mesh.face(t) {
+                    if depth[g as usize] == NONE {
+                        parent_he[g as usize] = t;
+                        depth[g as usize] = depth[f as usize] + 1;
+                        faces.push(g);
+                        queue.push_back(g);
+                    }
+                }
+            }
+        }
+
+        DualSpanningTree { faces, parent_he, depth, has_boundary }
+    }
+}
+
+/// `T_p` of [`DualTree`]: per mesh vertex its parent halfedge and depth, and
+/// per mesh edge whether it is a tree edge.
+struct PrimalSpanningTree {
+    parent_he: Vec<u32>,
+    depth: Vec<u32>,
+    in_tp: Vec<bool>,
+}
+
+impl PrimalSpanningTree {
+    /// Grows `T_p` over the edges of `comp_edges` not dual to `T` (`in_t`),
+    /// spanning `vertices`.
+    fn grow(mesh: &TriMesh, free: &[bool], in_t: &[bool], comp_edges: &[u32], vertices: &[u32]) -> PrimalSpanningTree {
+        // T_p: breadth-first over primal edges not dual to T.
+        let nv = mesh.n_vertices();
+        let mut primal_parent_he = vec![NONE; nv];
+        let mut primal_depth = vec![NONE; nv];
+        let mut in_tp = vec![false; mesh.n_edges()];
+        // Fewest non-free edges from the root (a 0-1 breadth-first search;
+        // without free edges a plain one): with a free boundary, T_p runs
+        // along the free edges wherever it can, so a free vertex's parent
+        // edge is a free port (no integer) except where a loop joins the rest.
+        let cost = |e: u32| u32::from(!is_free_edge(free, e));
+        let root_v = match comp_edges.iter().find(|&&e| is_free_edge(free, e)) {
+            Some(&e) => mesh.edge_vertices(e)[0],
+            None => vertices[0],
+        };
+        let mut dist = vec![u32::MAX; nv];
+        let mut done = vec![false; nv];
+        dist[root_v as usize] = 0;
+        primal_depth[root_v as usize] = 0;
+        let mut vq = VecDeque::from([root_v]);
+        while let Some(v) = vq.pop_front() {
+            if std::mem::replace(&mut done[v as usize], true) {
+                continue;
+            }
+            let ph = primal_parent_he[v as usize];
+            if ph != NONE {
+                in_tp[mesh.edge(ph) as usize] = true;
+                primal_depth[v as usize] = primal_depth[mesh.tail(ph) as usize] + 1;
+            }
+            for h in mesh.outgoing(v) {
+                let e = mesh.edge(h);
+                let w = mesh.head(h);
+                let d = dist[v as usize] + cost(e);
+                if !in_t[e as usize] && !done[w as usize] && d < dist[w as usize] {
+                    dist[w as usize] = d;
+                    primal_parent_he[w as usize] = h;
+                    if cost(e) == 0 {
+                        vq.push_front(w);
+                    } else {
+                        vq.push_back(w);
+                    }
+                }
+            }
+        }
+        debug_assert!(vertices.iter().all(|&v| primal_depth[v as usize] != NONE), "T_p spans the component");
+        PrimalSpanningTree { parent_he: primal_parent_he, depth: primal_depth, in_tp }
     }
 }
 

@@ -203,88 +203,11 @@ impl<'a> ComponentSystem<'a> {
             local[v as usize] = i as u32;
         }
 
-        // Per-vertex geometry on the component.
-        let mut angle_sum = vec![0.0; nv];
-        let mut area = vec![0.0; nv];
-        let (angles, areas) = (mesh.corner_angles(), mesh.face_areas());
-        for &f in &tree.faces {
-            let tri = mesh.faces()[f as usize];
-            let a = areas[f as usize];
-            for k in 0..3 {
-                let i = local[tri[k] as usize] as usize;
-                angle_sum[i] += angles[f as usize][k];
-                area[i] += a / 3.0;
-            }
-        }
+        let (area, defect) = vertex_geometry(mesh, &tree, &local);
         let total_area: f64 = area.iter().sum();
-        let defect: Vec<f64> = tree
-            .vertices
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| if mesh.is_boundary_vertex(v) { PI } else { 2.0 * PI } - angle_sum[i])
-            .collect();
-
-        let continuous: Vec<bool> =
-            tree.g_edges.iter().map(|&e| is_free_edge(free, e)).collect();
-        // Vertex cycles in the path basis.
-        let cycles: Vec<VertexCycle> = tree
-            .vertices
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| {
-                let cycle = vertex_cycle(mesh, v);
-                let transport = cycle_transport(mesh, &cycle);
-                let j = ((defect[i] - transport) / (2.0 * PI)).round() as i64;
-                let g = cycle_signs(mesh, &tree, &cycle);
-                let free = g.iter().any(|&(g, _)| continuous[g as usize]);
-                VertexCycle { g, transport, j, free }
-            })
-            .collect();
-
-        // Boundary turning: peel what determines single p's, pin the rest.
-        let mut fixed: Vec<Option<i64>> = vec![None; ng];
-        let mut pending: Vec<usize> =
-            (0..nv).filter(|&i| mesh.is_boundary_vertex(tree.vertices[i]) && !cycles[i].free).collect();
-        let target = |i: usize| boundary_k[tree.vertices[i] as usize] as i64 - 4 * cycles[i].j;
-        loop {
-            let mut progress = false;
-            let mut still = Vec::new();
-            for &i in &pending {
-                let unknown: Vec<&(u32, i32)> = cycles[i].g.iter().filter(|(g, _)| fixed[*g as usize].is_none()).collect();
-                let known: i64 = cycles[i]
-                    .g
-                    .iter()
-                    .filter_map(|&(g, s)| fixed[g as usize].map(|p| s as i64 * p))
-                    .sum();
-                match unknown.len() {
-                    0 => {
-                        if known != target(i) {
-                            return Err(ConeError::InconsistentBoundary { vertex: tree.vertices[i] });
-                        }
-                        progress = true;
-                    }
-                    1 => {
-                        let (g, s) = *unknown[0];
-                        fixed[g as usize] = Some((target(i) - known) * s as i64);
-                        progress = true;
-                    }
-                    _ => still.push(i),
-                }
-            }
-            pending = still;
-            if !progress || pending.is_empty() {
-                break;
-            }
-        }
-
-        // Pins that repeat others or the fixes peeling made make the KKT
-        // singular: keep an independent set (the boundary rows of a
-        // component are consistent, so the others hold too).
-        let mut rows: Vec<Vec<(usize, i64)>> = (0..ng).filter(|&g| fixed[g].is_some()).map(|g| vec![(g, 1)]).collect();
-        let n_fixed_rows = rows.len();
-        rows.extend(pending.iter().map(|&i| cycles[i].g.iter().map(|&(g, s)| (g as usize, s as i64)).collect()));
-        let keep = crate::linalg::independent_rows(&rows, ng);
-        let pending: Vec<usize> = pending.iter().zip(&keep[n_fixed_rows..]).filter(|(_, &k)| k).map(|(&i, _)| i).collect();
+        let continuous: Vec<bool> = tree.g_edges.iter().map(|&e| is_free_edge(free, e)).collect();
+        let cycles = vertex_cycles(mesh, &tree, &defect, &continuous);
+        let BoundaryRows { fixed, pins } = peel_boundary(mesh, &tree, &cycles, boundary_k)?;
 
         // Assemble.
         let n = nv + nh + ng;
@@ -364,11 +287,11 @@ impl<'a> ComponentSystem<'a> {
             row += 1;
         }
         // Pin rows.
-        for &i in &pending {
+        for &(i, target) in &pins {
             for &(g, s) in &cycles[i].g {
                 c.push((row, p0 + g as usize, s as f64));
             }
-            rhs.push(target(i) as f64);
+            rhs.push(target as f64);
             row += 1;
         }
         let m = row;
@@ -830,6 +753,110 @@ pub(crate) fn test_system_free(mesh: &TriMesh) -> ComponentSystem<'_> {
     let boundary_k = crate::features::boundary_turning(mesh);
     let free: Vec<bool> = (0..mesh.n_edges() as u32).map(|e| mesh.is_boundary_edge(e)).collect();
     ComponentSystem::new(mesh, 0, &boundary_k, &free, Weights { alpha_smooth: 0.01, miq: false }).unwrap()
+}
+
+/// Per local vertex of the component of `tree`: its barycentric area (a third
+/// of each incident face's) and its angle defect (sec. 5.2: `2π − Σθ` inside,
+/// `π − Σθ` on the boundary), summed over `tree.faces` in that order.
+fn vertex_geometry(mesh: &TriMesh, tree: &DualTree, local: &[u32]) -> (Vec<f64>, Vec<f64>) {
+    let nv = tree.vertices.len();
+    let mut angle_sum = vec![0.0; nv];
+    let mut area = vec![0.0; nv];
+    let (angles, areas) = (mesh.corner_angles(), mesh.face_areas());
+    for &f in &tree.faces {
+        let tri = mesh.faces()[f as usize];
+        let a = areas[f as usize];
+        for k in 0..3 {
+            let i = local[tri[k] as usize] as usize;
+            angle_sum[i] += angles[f as usize][k];
+            area[i] += a / 3.0;
+        }
+    }
+    let defect = tree
+        .vertices
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| if mesh.is_boundary_vertex(v) { PI } else { 2.0 * PI } - angle_sum[i])
+        .collect();
+    (area, defect)
+}
+
+/// The dual cycle of every local vertex in the path basis of `tree`, with its
+/// transport and `j_v = (K_v − transport) / 2π` (rounded: an integer up to
+/// round-off); `continuous` marks the `G` edges whose `p` is free.
+fn vertex_cycles(mesh: &TriMesh, tree: &DualTree, defect: &[f64], continuous: &[bool]) -> Vec<VertexCycle> {
+    tree.vertices
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let cycle = vertex_cycle(mesh, v);
+            let transport = cycle_transport(mesh, &cycle);
+            let j = ((defect[i] - transport) / (2.0 * PI)).round() as i64;
+            let g = cycle_signs(mesh, tree, &cycle);
+            let free = g.iter().any(|&(g, _)| continuous[g as usize]);
+            VertexCycle { g, transport, j, free }
+        })
+        .collect()
+}
+
+/// Boundary turning (sec. 5): the cycle of a boundary vertex (not on a free
+/// edge) must sum to its turning integer `boundary_k[v] − 4 j_v`. Rows that
+/// leave a single `p` unknown fix it, repeatedly; returns those fixes (per `G`
+/// edge) and the rows left over as `(local vertex, target)` pins, reduced to an
+/// independent set (a repeated pin would make the KKT singular; the boundary
+/// rows of a component are consistent, so the dropped ones hold too). Errs
+/// when a fully known row disagrees with its target.
+fn peel_boundary(
+    mesh: &TriMesh,
+    tree: &DualTree,
+    cycles: &[VertexCycle],
+    boundary_k: &[i32],
+) -> Result<BoundaryRows, ConeError> {
+    let ng = tree.g_edges.len();
+    let mut fixed: Vec<Option<i64>> = vec![None; ng];
+    let target = |i: usize| boundary_k[tree.vertices[i] as usize] as i64 - 4 * cycles[i].j;
+    let mut pending: Vec<usize> =
+        (0..cycles.len()).filter(|&i| mesh.is_boundary_vertex(tree.vertices[i]) && !cycles[i].free).collect();
+    loop {
+        let mut progress = false;
+        let mut still = Vec::new();
+        for &i in &pending {
+            let unknown: Vec<&(u32, i32)> = cycles[i].g.iter().filter(|(g, _)| fixed[*g as usize].is_none()).collect();
+            let known: i64 = cycles[i].g.iter().filter_map(|&(g, s)| fixed[g as usize].map(|p| s as i64 * p)).sum();
+            match unknown.len() {
+                0 => {
+                    if known != target(i) {
+                        return Err(ConeError::InconsistentBoundary { vertex: tree.vertices[i] });
+                    }
+                    progress = true;
+                }
+                1 => {
+                    let (g, s) = *unknown[0];
+                    fixed[g as usize] = Some((target(i) - known) * s as i64);
+                    progress = true;
+                }
+                _ => still.push(i),
+            }
+        }
+        pending = still;
+        if !progress || pending.is_empty() {
+            break;
+        }
+    }
+    let mut rows: Vec<Vec<(usize, i64)>> = (0..ng).filter(|&g| fixed[g].is_some()).map(|g| vec![(g, 1)]).collect();
+    let n_fixed_rows = rows.len();
+    rows.extend(pending.iter().map(|&i| cycles[i].g.iter().map(|&(g, s)| (g as usize, s as i64)).collect()));
+    let keep = crate::linalg::independent_rows(&rows, ng);
+    let pins = pending.iter().zip(&keep[n_fixed_rows..]).filter(|(_, &k)| k).map(|(&i, _)| (i, target(i))).collect();
+    Ok(BoundaryRows { fixed, pins })
+}
+
+/// What [`peel_boundary`] leaves for the KKT: the `p` it fixed and the rows to pin.
+struct BoundaryRows {
+    /// Per `G` edge, the value of `p` when a boundary row determines it.
+    fixed: Vec<Option<i64>>,
+    /// Independent boundary rows left: `(local vertex, target)`.
+    pins: Vec<(usize, i64)>,
 }
 
 /// The `G` edges a cycle crosses, with the sign `+1` when the cycle crosses
