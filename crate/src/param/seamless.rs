@@ -257,6 +257,39 @@ fn folded_faces(mesh: &TriMesh, sys: &System, uv: &[[f64; 2]], cone_angle: &[f64
     bad
 }
 
+impl System {
+    /// Sets up the shared unknowns of `cut` ([`unknowns`]), one element per
+    /// face, the constraint rows, and factors the KKT with unit weights (the
+    /// system of Poisson (23) and ARAP).
+    fn new(mesh: &TriMesh, field: &CrossField, cut: &CutGraph) -> Result<System, ParamError> {
+        let nf = mesh.n_faces();
+        let nw = cut.n_wedges;
+        let (vars, n_unknowns) = unknowns(mesh, field, cut);
+        let elements: Vec<Element> = (0..nf as u32)
+            .map(|f| {
+                let (q, area) = local_triangle(mesh, f);
+                let c = 3 * f as usize;
+                let w = [0, 1, 2].map(|k| cut.wedge[c + k] as usize);
+                Element::new(q, area, w, [w.map(|i| vars[0][i]), w.map(|i| vars[1][i])])
+            })
+            .collect();
+
+        let (constraints, n_rows) = constraint_rows(mesh, cut, &vars, n_unknowns);
+        let a = System::a_triplets(&elements, &vec![1.0; nf]);
+        let kkt = Kkt::assemble(&a, n_unknowns, &constraints, n_rows)?;
+        let mut solver = LdltSolver::with_options(
+            &kkt.pattern,
+            &kkt.signs,
+            // Small regularization: the constraint pivots are exact zeros before
+            // their primal neighbours are eliminated; a smaller delta refines faster here.
+            FactorOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..FactorOptions::default() },
+        )?;
+        solver.factorize(&kkt.values)?;
+        let projector = NullSpaceProjector::new(&constraints, n_unknowns, n_rows).ok();
+        Ok(System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver: Some(solver), projector })
+    }
+}
+
 /// Builds the constrained system, runs Poisson (23), ARAP, the repair (only
 /// when ARAP folds) and the injective refinement.
 ///
@@ -280,32 +313,8 @@ pub fn solve(
 ) -> Result<SeamlessResult, ParamError> {
     progress(ParamProgress::Poisson);
     let nf = mesh.n_faces();
-    let nw = cut.n_wedges;
-    let (vars, n_unknowns) = unknowns(mesh, field, cut);
-    let elements: Vec<Element> = (0..nf as u32)
-        .map(|f| {
-            let (q, area) = local_triangle(mesh, f);
-            let c = 3 * f as usize;
-            let w = [0, 1, 2].map(|k| cut.wedge[c + k] as usize);
-            Element::new(q, area, w, [w.map(|i| vars[0][i]), w.map(|i| vars[1][i])])
-        })
-        .collect();
-
-    let (constraints, n_rows) = constraint_rows(mesh, cut, &vars, n_unknowns);
+    let mut sys = System::new(mesh, field, cut)?;
     let mut weights = vec![1.0; nf];
-    let a = System::a_triplets(&elements, &weights);
-    let kkt = Kkt::assemble(&a, n_unknowns, &constraints, n_rows)?;
-    let mut solver = LdltSolver::with_options(
-        &kkt.pattern,
-        &kkt.signs,
-        // Small regularization: the constraint pivots are exact zeros before
-        // their primal neighbours are eliminated; a smaller delta refines faster here.
-        FactorOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..FactorOptions::default() },
-    )?;
-    solver.factorize(&kkt.values)?;
-    let projector = NullSpaceProjector::new(&constraints, n_unknowns, n_rows).ok();
-    let sys = System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver: Some(solver), projector };
-    let mut sys = sys;
 
     // Poisson (23) with the field's target Jacobians (B.1).
     let mut r: Vec<[[f64; 2]; 2]> = (0..nf).map(|f| field.target(f)).collect();
@@ -386,30 +395,17 @@ pub fn solve(
     }
     timings.repair = clock.lap();
 
-    // Untangling of what the repair left folded, from its best map,
-    // preconditioned by the unweighted Poisson KKT (one factorization).
-    let (mut untangle_iterations, mut realized) = (0, Vec::new());
+    // Untangling of what the repair left folded, from its best map.
+    let mut untangle_iterations = 0;
+    let mut realized = Vec::new();
     if best_flips > 0 && options.untangle.max_outer > 0 && sys.projector.is_some() {
-        weights.iter_mut().for_each(|w| *w = 1.0);
-        sys.refactor(&weights)?;
-        let precondition = |q: &mut [f64]| sys.precondition(q);
-        let mut x = sys.unknowns_of(&best_uv);
-        let stats = untangle(&sys.elements, &precondition, &mut x, &options.untangle);
-        untangle_iterations = stats.iterations;
-        if let Some(projector) = &sys.projector {
-            projector.project(&mut x, CONSTRAINT_TOLERANCE, 3);
-        }
-        let untangled = sys.wedges_of(&x);
-        let scale = x.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-        let feasible = sys.constraint_residual(&x) <= 1e-12 * scale;
-        if feasible && stats.inverted == 0 && flipped_faces(&sys, &untangled).is_empty() {
-            // Every triangle positive: locally injective away from the cones
-            // and corners, some of which the map may realize with another
-            // angle than placed (see `realized_cones`).
-            realized = realized_cones(placement, &sys, &untangled, &mut cone_angle);
+        let untangled;
+        (untangle_iterations, untangled) = untangle_folds(&mut sys, &mut weights, placement, &best_uv, &mut cone_angle, options)?;
+        if let Some(u) = untangled {
+            realized = u.realized;
             best_flips = 0;
-            energy = arap_energy(&sys, &untangled);
-            best_uv = untangled;
+            energy = arap_energy(&sys, &u.uv);
+            best_uv = u.uv;
         }
         // A partly untangled map is not kept: the flip refinement splits
         // the faces the repair left flipped, and fewer of them there (a
@@ -457,6 +453,47 @@ pub fn solve(
         realized,
         energy,
     })
+}
+
+/// Untangles the folded map `start` (sec. [`super::untangle`]), preconditioned
+/// by the unweighted KKT (`weights` reset to 1, one factorization). Returns
+/// the iterations, and the map when it satisfies the constraints with every
+/// triangle positive, with the cones it realizes otherwise than placed
+/// (`cone_angle` updated to match).
+fn untangle_folds(
+    sys: &mut System,
+    weights: &mut [f64],
+    placement: &ConePlacement,
+    start: &[[f64; 2]],
+    cone_angle: &mut [f64],
+    options: &ParamOptions,
+) -> Result<(usize, Option<Untangled>), ParamError> {
+    weights.iter_mut().for_each(|w| *w = 1.0);
+    sys.refactor(weights)?;
+    let precondition = |q: &mut [f64]| sys.precondition(q);
+    let mut x = sys.unknowns_of(start);
+    let stats = untangle(&sys.elements, &precondition, &mut x, &options.untangle);
+    if let Some(projector) = &sys.projector {
+        projector.project(&mut x, CONSTRAINT_TOLERANCE, 3);
+    }
+    let uv = sys.wedges_of(&x);
+    let scale = x.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let feasible = sys.constraint_residual(&x) <= 1e-12 * scale;
+    if !(feasible && stats.inverted == 0 && flipped_faces(sys, &uv).is_empty()) {
+        return Ok((stats.iterations, None));
+    }
+    // Every triangle positive: locally injective away from the cones and
+    // corners, some of which the map may realize with another angle than
+    // placed (see `realized_cones`).
+    let realized = realized_cones(placement, sys, &uv, cone_angle);
+    Ok((stats.iterations, Some(Untangled { uv, realized })))
+}
+
+/// A fold-free map found by [`untangle_folds`].
+struct Untangled {
+    uv: Vec<[f64; 2]>,
+    /// `(cut vertex, k)` of the cones realized otherwise than placed.
+    realized: Vec<(u32, i32)>,
 }
 
 /// Injective refinement ([`super::injective`]) of the feasible, fold-free
