@@ -71,141 +71,271 @@ pub(crate) struct Analysis {
     pub report: MeshReport,
 }
 
-/// Analyses `raw` given its welding (`weld(raw)` or `Welded::by_index(raw)`).
+/// Analyses `raw` given its welding (`weld(raw)` or `Welded::by_index(raw)`):
+/// one phase per kind of check, each returning its problems and figures.
 pub(crate) fn analyze_welded(raw: &RawMesh, welded: Welded) -> Analysis {
     let n_src = raw.positions.len();
     let nf = raw.triangles.len();
     let nv = welded.positions.len();
     let tris = &welded.triangles;
 
-    // --- indices, coordinates, references (source indices) ---
-    let mut p_range = Vec::new();
-    let mut use_face = vec![true; nf];
-    for (f, t) in raw.triangles.iter().enumerate() {
-        for &i in t {
-            if i as usize >= n_src {
-                p_range.push(Problem::IndexOutOfRange {
-                    face: f as u32,
-                    index: i,
-                    vertex_count: n_src.min(u32::MAX as usize) as u32,
-                });
-                use_face[f] = false;
-            }
+    let src = SourceChecks::run(raw, &welded);
+    let use_face = &src.use_face;
+    let deg = FaceChecks::run(raw, &welded, use_face);
+    let edges = EdgeTable::build(nv, tris, use_face);
+    let ne = edges.n_edges();
+    let ec = EdgeChecks::run(&edges, tris, &deg.degenerate);
+    let (face_component, nc) = edge_components(&edges, use_face);
+    let fans = vertex_fans(&edges, tris, use_face, nv);
+    let mut p_nm_vertex = Vec::new();
+    for (v, &n) in fans.iter().enumerate() {
+        if n > 1 {
+            p_nm_vertex.push(Problem::NonManifoldVertex { vertex: v as u32, fans: n });
         }
     }
-    let mut p_finite = Vec::new();
-    let mut p_unref = Vec::new();
-    let mut referenced_sources = 0usize;
-    for (s, p) in raw.positions.iter().enumerate() {
-        if welded.source_to_welded.get(s).copied().unwrap_or(NO_VERTEX) == NO_VERTEX {
-            p_unref.push(Problem::UnreferencedVertex { vertex: s as u32 });
-        } else {
-            referenced_sources += 1;
-            if !p.iter().all(|c| c.is_finite()) {
-                p_finite.push(Problem::NonFiniteCoordinate { vertex: s as u32 });
-            }
-        }
-    }
+    let (n_loops, loops_per_comp) = boundary_loops(&edges, &ec.boundary_edges, &face_component, nc);
+    let (f_c, chi_c) = component_euler_characteristics(&edges, tris, use_face, &face_component, nc, nv);
+    let genus: Vec<i64> = (0..nc).map(|c| (2 - chi_c[c] - loops_per_comp[c] as i64) / 2).collect();
+    let (p_degen, p_zero_len, p_zero_area) = (deg.degen, deg.zero_len, deg.zero_area);
+    let (p_dup, p_nm_edge, p_orient) = (ec.dup, ec.nm_edge, ec.orient);
 
-    // --- per-face degeneracy ---
-    let mut p_degen = Vec::new();
-    let mut p_zero_len = Vec::new();
-    let mut p_zero_area = Vec::new();
-    let mut degenerate = vec![false; nf];
-    for f in 0..nf {
-        if !use_face[f] {
-            continue;
+    let mut manifold = vec![true; nc];
+    {
+        let mut bad_face = |f: u32| {
+            if let Some(&c) = face_component.get(f as usize) {
+                if c != u32::MAX {
+                    manifold[c as usize] = false;
+                }
+            }
+        };
+        for p in p_degen.iter().chain(&p_zero_len).chain(&p_dup).chain(&p_nm_edge).chain(&p_orient) {
+            match p {
+                Problem::DegenerateFace { face, .. } | Problem::ZeroLengthEdge { face, .. } => bad_face(*face),
+                Problem::DuplicateFace { faces } | Problem::InconsistentOrientation { faces, .. } => {
+                    faces.iter().for_each(|&f| bad_face(f))
+                }
+                Problem::NonManifoldEdge { faces, .. } => faces.iter().for_each(|&f| bad_face(f)),
+                _ => {}
+            }
         }
-        let s = raw.triangles[f];
-        let w = tris[f];
-        if s[0] == s[1] || s[1] == s[2] || s[0] == s[2] {
-            p_degen.push(Problem::DegenerateFace { face: f as u32, vertices: w });
-            degenerate[f] = true;
-        } else if w[0] == w[1] || w[1] == w[2] || w[0] == w[2] {
-            let (i, j) = if w[0] == w[1] {
-                (0, 1)
-            } else if w[1] == w[2] {
-                (1, 2)
-            } else {
-                (2, 0)
-            };
-            p_zero_len.push(Problem::ZeroLengthEdge { edge: [s[i], s[j]], face: f as u32 });
-            degenerate[f] = true;
-        } else {
-            let p = [
-                welded.positions[w[0] as usize],
-                welded.positions[w[1] as usize],
-                welded.positions[w[2] as usize],
-            ];
-            if p.iter().all(|q| q.iter().all(|c| c.is_finite())) {
-                let e0 = sub(p[1], p[0]);
-                let e1 = sub(p[2], p[0]);
-                let e2 = sub(p[2], p[1]);
-                let c = cross(e0, e1);
-                let c2 = dot(c, c);
-                let m = dot(e0, e0).max(dot(e1, e1)).max(dot(e2, e2));
-                let tol = ZERO_AREA_REL * m;
-                if c2 <= tol * tol {
-                    p_zero_area.push(Problem::ZeroAreaFace { face: f as u32, area: 0.5 * c2.sqrt() });
+        if !p_nm_vertex.is_empty() {
+            for f in 0..nf {
+                if use_face[f] && tris[f].iter().any(|&v| fans[v as usize] > 1) {
+                    bad_face(f as u32);
                 }
             }
         }
     }
+    let vertex_components = vertex_connected_components(tris, use_face, nv);
+    let faces_used = use_face.iter().filter(|&&u| u).count() as i64;
 
-    // --- edges ---
-    let edges = EdgeTable::build(nv, tris, &use_face);
-    let ne = edges.n_edges();
-    let mut boundary_edges = Vec::new();
-    let mut non_manifold_edges = 0usize;
-    let mut p_nm_edge = Vec::new();
-    let mut p_orient = Vec::new();
-    let mut p_dup: Vec<(u32, u32)> = Vec::new();
-    let mut nd: Vec<u32> = Vec::new();
-    let mut key_faces: Vec<(u32, [u32; 3])> = Vec::new();
-    for e in 0..ne {
-        let hs = edges.halfedges(e);
-        let [lo, hi] = edges.verts[e];
-        match hs.len() {
-            1 => boundary_edges.push(e as u32),
-            2 => {}
-            _ => non_manifold_edges += 1,
-        }
-        if hs.len() < 2 {
-            continue;
-        }
-        nd.clear();
-        nd.extend(hs.iter().copied().filter(|&h| !degenerate[(h / 3) as usize]));
-        if lo != hi {
-            if nd.len() > 2 {
-                p_nm_edge.push(Problem::NonManifoldEdge { edge: [lo, hi], faces: nd.iter().map(|h| h / 3).collect() });
-            } else if nd.len() == 2 && he_tail(tris, nd[0]) == he_tail(tris, nd[1]) {
-                p_orient.push(Problem::InconsistentOrientation {
-                    edge: [he_tail(tris, nd[0]), he_head(tris, nd[0])],
-                    faces: [nd[0] / 3, nd[1] / 3],
-                });
-            }
-        }
-        // Duplicate faces: checked once per face, on the edge of its two
-        // smallest vertex ids.
-        key_faces.clear();
-        for &h in &nd {
-            let f = h / 3;
-            let mut s = tris[f as usize];
-            s.sort_unstable();
-            if s[0] == lo && s[1] == hi && key_faces.last().map(|k| k.0) != Some(f) {
-                key_faces.push((f, s));
-            }
-        }
-        for j in 1..key_faces.len() {
-            if let Some(i) = (0..j).find(|&i| key_faces[i].1 == key_faces[j].1) {
-                p_dup.push((key_faces[i].0, key_faces[j].0));
-            }
-        }
+    let non_manifold_vertices = p_nm_vertex.len();
+    let mut problems = src.range;
+    for group in [src.finite, src.unref, p_degen, p_zero_len, p_zero_area, p_dup, p_nm_edge, p_nm_vertex, p_orient] {
+        problems.extend(group);
     }
-    p_dup.sort_unstable_by_key(|&(a, b)| (b, a));
-    let p_dup: Vec<Problem> = p_dup.into_iter().map(|(a, b)| Problem::DuplicateFace { faces: [a, b] }).collect();
+    let report = MeshReport {
+        vertices: nv,
+        faces: nf,
+        boundary_loops: n_loops,
+        components: nc,
+        vertex_connected_components: vertex_components,
+        euler_characteristic: nv as i64 - ne as i64 + faces_used,
+        genus,
+        problems,
+        source_vertices: n_src,
+        // A split pinch vertex adds a vertex without a source of its own.
+        merged_vertices: src.referenced_sources.saturating_sub(nv),
+        edges: ne,
+        boundary_edges: ec.boundary_edges.len(),
+        non_manifold_edges: ec.non_manifold_edges,
+        non_manifold_vertices,
+        euler_characteristic_per_component: chi_c,
+        boundary_loops_per_component: loops_per_comp,
+        faces_per_component: f_c.iter().map(|&x| x as usize).collect(),
+        component_is_manifold: manifold,
+    };
+    Analysis { welded, edges, face_component, report }
+}
 
-    // --- components (edge-connected) ---
+
+/// Index range, coordinates and references, in source indices.
+struct SourceChecks {
+    range: Vec<Problem>,
+    finite: Vec<Problem>,
+    unref: Vec<Problem>,
+    /// Per face: all its indices are in range (the other phases skip it otherwise).
+    use_face: Vec<bool>,
+    referenced_sources: usize,
+}
+
+impl SourceChecks {
+    fn run(raw: &RawMesh, welded: &Welded) -> SourceChecks {
+        let n_src = raw.positions.len();
+        let nf = raw.triangles.len();
+        let mut p_range = Vec::new();
+        let mut use_face = vec![true; nf];
+        for (f, t) in raw.triangles.iter().enumerate() {
+            for &i in t {
+                if i as usize >= n_src {
+                    p_range.push(Problem::IndexOutOfRange {
+                        face: f as u32,
+                        index: i,
+                        vertex_count: n_src.min(u32::MAX as usize) as u32,
+                    });
+                    use_face[f] = false;
+                }
+            }
+        }
+        let mut p_finite = Vec::new();
+        let mut p_unref = Vec::new();
+        let mut referenced_sources = 0usize;
+        for (s, p) in raw.positions.iter().enumerate() {
+            if welded.source_to_welded.get(s).copied().unwrap_or(NO_VERTEX) == NO_VERTEX {
+                p_unref.push(Problem::UnreferencedVertex { vertex: s as u32 });
+            } else {
+                referenced_sources += 1;
+                if !p.iter().all(|c| c.is_finite()) {
+                    p_finite.push(Problem::NonFiniteCoordinate { vertex: s as u32 });
+                }
+            }
+        }
+        SourceChecks { range: p_range, finite: p_finite, unref: p_unref, use_face, referenced_sources }
+    }
+}
+
+/// Degenerate faces (a repeated source index), zero-length edges (welded
+/// together) and zero-area faces (relative to the longest edge, [`ZERO_AREA_REL`]).
+struct FaceChecks {
+    degen: Vec<Problem>,
+    zero_len: Vec<Problem>,
+    zero_area: Vec<Problem>,
+    /// Per face: degenerate or with a zero-length edge (left out of the edge checks).
+    degenerate: Vec<bool>,
+}
+
+impl FaceChecks {
+    fn run(raw: &RawMesh, welded: &Welded, use_face: &[bool]) -> FaceChecks {
+        let nf = raw.triangles.len();
+        let tris = &welded.triangles;
+        let mut p_degen = Vec::new();
+        let mut p_zero_len = Vec::new();
+        let mut p_zero_area = Vec::new();
+        let mut degenerate = vec![false; nf];
+        for f in 0..nf {
+            if !use_face[f] {
+                continue;
+            }
+            let s = raw.triangles[f];
+            let w = tris[f];
+            if s[0] == s[1] || s[1] == s[2] || s[0] == s[2] {
+                p_degen.push(Problem::DegenerateFace { face: f as u32, vertices: w });
+                degenerate[f] = true;
+            } else if w[0] == w[1] || w[1] == w[2] || w[0] == w[2] {
+                let (i, j) = if w[0] == w[1] {
+                    (0, 1)
+                } else if w[1] == w[2] {
+                    (1, 2)
+                } else {
+                    (2, 0)
+                };
+                p_zero_len.push(Problem::ZeroLengthEdge { edge: [s[i], s[j]], face: f as u32 });
+                degenerate[f] = true;
+            } else {
+                let p = [
+                    welded.positions[w[0] as usize],
+                    welded.positions[w[1] as usize],
+                    welded.positions[w[2] as usize],
+                ];
+                if p.iter().all(|q| q.iter().all(|c| c.is_finite())) {
+                    let e0 = sub(p[1], p[0]);
+                    let e1 = sub(p[2], p[0]);
+                    let e2 = sub(p[2], p[1]);
+                    let c = cross(e0, e1);
+                    let c2 = dot(c, c);
+                    let m = dot(e0, e0).max(dot(e1, e1)).max(dot(e2, e2));
+                    let tol = ZERO_AREA_REL * m;
+                    if c2 <= tol * tol {
+                        p_zero_area.push(Problem::ZeroAreaFace { face: f as u32, area: 0.5 * c2.sqrt() });
+                    }
+                }
+            }
+        }
+        FaceChecks { degen: p_degen, zero_len: p_zero_len, zero_area: p_zero_area, degenerate }
+    }
+}
+
+/// Boundary and non-manifold edges, inconsistent orientation and duplicate faces.
+struct EdgeChecks {
+    boundary_edges: Vec<u32>,
+    /// Edges with more than two faces, counting every face.
+    non_manifold_edges: usize,
+    nm_edge: Vec<Problem>,
+    orient: Vec<Problem>,
+    dup: Vec<Problem>,
+}
+
+impl EdgeChecks {
+    fn run(edges: &EdgeTable, tris: &[[u32; 3]], degenerate: &[bool]) -> EdgeChecks {
+        let ne = edges.n_edges();
+        let mut boundary_edges = Vec::new();
+        let mut non_manifold_edges = 0usize;
+        let mut p_nm_edge = Vec::new();
+        let mut p_orient = Vec::new();
+        let mut p_dup: Vec<(u32, u32)> = Vec::new();
+        let mut nd: Vec<u32> = Vec::new();
+        let mut key_faces: Vec<(u32, [u32; 3])> = Vec::new();
+        for e in 0..ne {
+            let hs = edges.halfedges(e);
+            let [lo, hi] = edges.verts[e];
+            match hs.len() {
+                1 => boundary_edges.push(e as u32),
+                2 => {}
+                _ => non_manifold_edges += 1,
+            }
+            if hs.len() < 2 {
+                continue;
+            }
+            nd.clear();
+            nd.extend(hs.iter().copied().filter(|&h| !degenerate[(h / 3) as usize]));
+            if lo != hi {
+                if nd.len() > 2 {
+                    p_nm_edge.push(Problem::NonManifoldEdge { edge: [lo, hi], faces: nd.iter().map(|h| h / 3).collect() });
+                } else if nd.len() == 2 && he_tail(tris, nd[0]) == he_tail(tris, nd[1]) {
+                    p_orient.push(Problem::InconsistentOrientation {
+                        edge: [he_tail(tris, nd[0]), he_head(tris, nd[0])],
+                        faces: [nd[0] / 3, nd[1] / 3],
+                    });
+                }
+            }
+            // Duplicate faces: checked once per face, on the edge of its two
+            // smallest vertex ids.
+            key_faces.clear();
+            for &h in &nd {
+                let f = h / 3;
+                let mut s = tris[f as usize];
+                s.sort_unstable();
+                if s[0] == lo && s[1] == hi && key_faces.last().map(|k| k.0) != Some(f) {
+                    key_faces.push((f, s));
+                }
+            }
+            for j in 1..key_faces.len() {
+                if let Some(i) = (0..j).find(|&i| key_faces[i].1 == key_faces[j].1) {
+                    p_dup.push((key_faces[i].0, key_faces[j].0));
+                }
+            }
+        }
+        p_dup.sort_unstable_by_key(|&(a, b)| (b, a));
+        let p_dup: Vec<Problem> = p_dup.into_iter().map(|(a, b)| Problem::DuplicateFace { faces: [a, b] }).collect();
+        EdgeChecks { boundary_edges, non_manifold_edges, nm_edge: p_nm_edge, orient: p_orient, dup: p_dup }
+    }
+}
+
+/// Edge-connected components: per face its component (`u32::MAX` for faces
+/// left out), numbered by smallest face; and their number.
+fn edge_components(edges: &EdgeTable, use_face: &[bool]) -> (Vec<u32>, usize) {
+    let nf = use_face.len();
+    let ne = edges.n_edges();
     let mut uf = UnionFind::new(nf);
     for e in 0..ne {
         let hs = edges.halfedges(e);
@@ -230,8 +360,14 @@ pub(crate) fn analyze_welded(raw: &RawMesh, welded: Welded) -> Analysis {
     }
     drop(uf);
     let nc = n_comp as usize;
+    (face_component, nc)
+}
 
-    // --- fans around vertices (corner union-find) ---
+/// Per welded vertex, the number of fans of faces around it (corners joined
+/// across the edges they share); more than one is a non-manifold vertex.
+fn vertex_fans(edges: &EdgeTable, tris: &[[u32; 3]], use_face: &[bool], nv: usize) -> Vec<u32> {
+    let nf = use_face.len();
+    let ne = edges.n_edges();
     let mut cuf = UnionFind::new(3 * nf);
     for e in 0..ne {
         let hs = edges.halfedges(e);
@@ -270,14 +406,12 @@ pub(crate) fn analyze_welded(raw: &RawMesh, welded: Welded) -> Analysis {
         }
     }
     drop(cuf);
-    let mut p_nm_vertex = Vec::new();
-    for (v, &n) in fans.iter().enumerate() {
-        if n > 1 {
-            p_nm_vertex.push(Problem::NonManifoldVertex { vertex: v as u32, fans: n });
-        }
-    }
+    fans
+}
 
-    // --- boundary loops: boundary edges joined at a vertex within a component ---
+/// Boundary loops (boundary edges joined at a vertex within a component):
+/// their number, and their number per component.
+fn boundary_loops(edges: &EdgeTable, boundary_edges: &[u32], face_component: &[u32], nc: usize) -> (usize, Vec<usize>) {
     let nb = boundary_edges.len();
     let mut ends: Vec<(u32, u32, u32)> = Vec::with_capacity(2 * nb);
     for (bi, &e) in boundary_edges.iter().enumerate() {
@@ -303,8 +437,20 @@ pub(crate) fn analyze_welded(raw: &RawMesh, welded: Welded) -> Analysis {
             loops_per_comp[face_component[(h / 3) as usize] as usize] += 1;
         }
     }
+    (n_loops, loops_per_comp)
+}
 
-    // --- per-component figures ---
+/// Per component: its faces and its Euler characteristic V − E + F.
+fn component_euler_characteristics(
+    edges: &EdgeTable,
+    tris: &[[u32; 3]],
+    use_face: &[bool],
+    face_component: &[u32],
+    nc: usize,
+    nv: usize,
+) -> (Vec<i64>, Vec<i64>) {
+    let nf = use_face.len();
+    let ne = edges.n_edges();
     let mut f_c = vec![0i64; nc];
     let mut e_c = vec![0i64; nc];
     let mut v_c = vec![0i64; nc];
@@ -343,36 +489,12 @@ pub(crate) fn analyze_welded(raw: &RawMesh, welded: Welded) -> Analysis {
         }
     }
     let chi_c: Vec<i64> = (0..nc).map(|c| v_c[c] - e_c[c] + f_c[c]).collect();
-    let genus: Vec<i64> = (0..nc).map(|c| (2 - chi_c[c] - loops_per_comp[c] as i64) / 2).collect();
+    (f_c, chi_c)
+}
 
-    let mut manifold = vec![true; nc];
-    {
-        let mut bad_face = |f: u32| {
-            if let Some(&c) = face_component.get(f as usize) {
-                if c != u32::MAX {
-                    manifold[c as usize] = false;
-                }
-            }
-        };
-        for p in p_degen.iter().chain(&p_zero_len).chain(&p_dup).chain(&p_nm_edge).chain(&p_orient) {
-            match p {
-                Problem::DegenerateFace { face, .. } | Problem::ZeroLengthEdge { face, .. } => bad_face(*face),
-                Problem::DuplicateFace { faces } | Problem::InconsistentOrientation { faces, .. } => {
-                    faces.iter().for_each(|&f| bad_face(f))
-                }
-                Problem::NonManifoldEdge { faces, .. } => faces.iter().for_each(|&f| bad_face(f)),
-                _ => {}
-            }
-        }
-        if !p_nm_vertex.is_empty() {
-            for f in 0..nf {
-                if use_face[f] && tris[f].iter().any(|&v| fans[v as usize] > 1) {
-                    bad_face(f as u32);
-                }
-            }
-        }
-    }
-    // Vertex-connected components: union vertices over faces.
+/// Components when faces sharing only a vertex also count as connected.
+fn vertex_connected_components(tris: &[[u32; 3]], use_face: &[bool], nv: usize) -> usize {
+    let nf = use_face.len();
     let mut vuf = UnionFind::new(nv);
     for f in 0..nf {
         if use_face[f] {
@@ -393,35 +515,7 @@ pub(crate) fn analyze_welded(raw: &RawMesh, welded: Welded) -> Analysis {
         }
     }
     drop(vuf);
-    let faces_used = use_face.iter().filter(|&&u| u).count() as i64;
-
-    let non_manifold_vertices = p_nm_vertex.len();
-    let mut problems = p_range;
-    for group in [p_finite, p_unref, p_degen, p_zero_len, p_zero_area, p_dup, p_nm_edge, p_nm_vertex, p_orient] {
-        problems.extend(group);
-    }
-    let report = MeshReport {
-        vertices: nv,
-        faces: nf,
-        boundary_loops: n_loops,
-        components: nc,
-        vertex_connected_components: vertex_components,
-        euler_characteristic: nv as i64 - ne as i64 + faces_used,
-        genus,
-        problems,
-        source_vertices: n_src,
-        // A split pinch vertex adds a vertex without a source of its own.
-        merged_vertices: referenced_sources.saturating_sub(nv),
-        edges: ne,
-        boundary_edges: nb,
-        non_manifold_edges,
-        non_manifold_vertices,
-        euler_characteristic_per_component: chi_c,
-        boundary_loops_per_component: loops_per_comp,
-        faces_per_component: f_c.iter().map(|&x| x as usize).collect(),
-        component_is_manifold: manifold,
-    };
-    Analysis { welded, edges, face_component, report }
+    vertex_components
 }
 
 pub(crate) use crate::vec3::{cross, dot, sub};
