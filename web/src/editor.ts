@@ -648,7 +648,7 @@ export class Editor {
     const hasUv = r.uv.length === (m.data.indices.length / 3) * 6;
     for (const radio of document.querySelectorAll<HTMLInputElement>('input[name=surface]')) {
       radio.disabled = radio.value !== 'shaded' && !hasUv;
-      radio.parentElement!.title = radio.disabled ? 'parametrization not available in this build' : '';
+      radio.parentElement!.title = radio.disabled ? 'the result has no UVs for every face' : '';
       if (radio.value === 'shaded') radio.checked = !hasUv;
       if (radio.value === 'checker') radio.checked = hasUv;
     }
