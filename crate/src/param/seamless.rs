@@ -314,7 +314,7 @@ pub fn solve(
     progress(ParamProgress::Poisson);
     let nf = mesh.n_faces();
     let mut sys = System::new(mesh, field, cut)?;
-    let mut weights = vec![1.0; nf];
+    let weights = vec![1.0; nf];
 
     // Poisson (23) with the field's target Jacobians (B.1).
     let mut r: Vec<[[f64; 2]; 2]> = (0..nf).map(|f| field.target(f)).collect();
@@ -325,74 +325,15 @@ pub fn solve(
     let fixed: Vec<bool> = (0..nf)
         .map(|f| options.fix_feature_rotations && (0..3).any(|k| field.isoline[3 * f + k] != NO_ISOLINE))
         .collect();
-    let (iterations, mut energy) = arap(&sys, &weights, &fixed, &mut r, &mut uv, options, 0, progress)?;
+    let (iterations, energy) = arap(&sys, &weights, &fixed, &mut r, &mut uv, options, 0, progress)?;
     timings.arap = clock.lap();
 
-    // Fold-over repair: raise the weight of flipped triangles and their
-    // neighbours (keeps every constraint: only A changes), re-run ARAP.
+    // Fold-over repair (only when ARAP folds), then relaxation.
     let mut cone_angle = interior_cone_angles(mesh, placement);
-    let mut flips = folded_faces(mesh, &sys, &uv, &cone_angle);
-    let flips_before = flips.len();
-    let (mut best_uv, mut best_flips) = (uv.clone(), flips.len());
-    let mut round = 0;
-    let mut pinned = fixed.clone();
-    let relax = options.refine.max_iterations == 0;
-    // Rounds go on while they make progress: finer meshes need more of them
-    // (the 52 k-face fandisk needed 13-24).
-    let mut stalled = 0;
-    while !flips.is_empty() && round < options.repair_rounds && stalled < REPAIR_PATIENCE {
-        round += 1;
-        progress(ParamProgress::Repair { round, flips: flips.len() });
-        for &f in &flips {
-            // Hold a flipped triangle's target at the field frame (an
-            // orientation-preserving rotation) instead of the closest rotation
-            // to its flipped Jacobian, and weight it up.
-            r[f] = field.target(f);
-            pinned[f] = true;
-            weights[f] = (weights[f] * 10.0).min(1e6);
-            for k in 0..3 {
-                let t = mesh.twin(3 * f as u32 + k);
-                if let Some(g) = mesh.face(t) {
-                    weights[g as usize] = (weights[g as usize] * 3.0).min(1e6);
-                }
-            }
-        }
-        sys.refactor(&weights)?;
-        let (_, e) = arap(&sys, &weights, &pinned, &mut r, &mut uv, options, 10, &mut |_| {})?;
-        energy = e;
-        flips = folded_faces(mesh, &sys, &uv, &cone_angle);
-        if flips.len() < best_flips {
-            best_flips = flips.len();
-            best_uv = uv.clone();
-            stalled = 0;
-        } else {
-            stalled += 1;
-        }
-        if flips.len() > REPAIR_DIVERGENCE * best_flips.max(REPAIR_DIVERGENCE_FLOOR) {
-            break;
-        }
-    }
-    // Relaxation (only without the injective refinement): once fold-free,
-    // decay the repair weights back towards 1 while the map stays fold-free.
-    if relax && best_flips == 0 && round > 0 {
-        uv = best_uv.clone();
-        for _ in 0..16 {
-            for w in weights.iter_mut() {
-                *w = 1.0 + (*w - 1.0) * 0.85;
-            }
-            sys.refactor(&weights)?;
-            let mut trial = uv.clone();
-            let mut r_trial = r.clone();
-            let (_, e) = arap(&sys, &weights, &pinned, &mut r_trial, &mut trial, options, 10, &mut |_| {})?;
-            if !folded_faces(mesh, &sys, &trial, &cone_angle).is_empty() {
-                break;
-            }
-            uv = trial;
-            r = r_trial;
-            energy = e;
-            best_uv = uv.clone();
-        }
-    }
+    let mut state = ArapState { weights, pinned: fixed, r, uv, energy };
+    let Repaired { mut best_uv, mut best_flips, rounds, flips_before } =
+        repair_folds(mesh, &mut sys, field, &mut state, &cone_angle, options, progress)?;
+    let ArapState { mut weights, mut energy, .. } = state;
     timings.repair = clock.lap();
 
     // Untangling of what the repair left folded, from its best map.
@@ -446,13 +387,109 @@ pub fn solve(
             arap_iterations: iterations,
             flips_before_repair: flips_before,
             flips_fixed: flips_before - best_flips,
-            repair_rounds: round,
+            repair_rounds: rounds,
             refine_iterations,
             untangle_iterations,
         },
         realized,
         energy,
     })
+}
+
+/// ARAP's state between runs: per-face weights, the faces whose rotation
+/// is held, the target rotations, the map (per wedge) and its energy.
+struct ArapState {
+    weights: Vec<f64>,
+    pinned: Vec<bool>,
+    r: Vec<[[f64; 2]; 2]>,
+    uv: Vec<[f64; 2]>,
+    energy: f64,
+}
+
+/// What [`repair_folds`] found: the map with the fewest folds and its count,
+/// the rounds run and the folds before the first.
+struct Repaired {
+    best_uv: Vec<[f64; 2]>,
+    best_flips: usize,
+    rounds: usize,
+    flips_before: usize,
+}
+
+/// Fold-over repair of the ARAP map in `state`: raises the weight of the
+/// folded triangles and their neighbours (only A changes: every constraint
+/// holds) and re-runs ARAP, while the rounds make progress; then, without
+/// the injective refinement and once fold-free, decays the weights back
+/// towards 1 while the map stays fold-free. Refactors `sys` per round.
+fn repair_folds(
+    mesh: &TriMesh,
+    sys: &mut System,
+    field: &CrossField,
+    state: &mut ArapState,
+    cone_angle: &[f64],
+    options: &ParamOptions,
+    progress: &mut dyn FnMut(ParamProgress),
+) -> Result<Repaired, ParamError> {
+    let mut flips = folded_faces(mesh, sys, &state.uv, cone_angle);
+    let flips_before = flips.len();
+    let (mut best_uv, mut best_flips) = (state.uv.clone(), flips.len());
+    let mut round = 0;
+    // Rounds go on while they make progress: finer meshes need more of them
+    // (the 52 k-face fandisk needed 13-24).
+    let mut stalled = 0;
+    while !flips.is_empty() && round < options.repair_rounds && stalled < REPAIR_PATIENCE {
+        round += 1;
+        progress(ParamProgress::Repair { round, flips: flips.len() });
+        for &f in &flips {
+            // Hold a flipped triangle's target at the field frame (an
+            // orientation-preserving rotation) instead of the closest rotation
+            // to its flipped Jacobian, and weight it up.
+            state.r[f] = field.target(f);
+            state.pinned[f] = true;
+            state.weights[f] = (state.weights[f] * 10.0).min(1e6);
+            for k in 0..3 {
+                let t = mesh.twin(3 * f as u32 + k);
+                if let Some(g) = mesh.face(t) {
+                    state.weights[g as usize] = (state.weights[g as usize] * 3.0).min(1e6);
+                }
+            }
+        }
+        sys.refactor(&state.weights)?;
+        let (_, e) = arap(sys, &state.weights, &state.pinned, &mut state.r, &mut state.uv, options, 10, &mut |_| {})?;
+        state.energy = e;
+        flips = folded_faces(mesh, sys, &state.uv, cone_angle);
+        if flips.len() < best_flips {
+            best_flips = flips.len();
+            best_uv = state.uv.clone();
+            stalled = 0;
+        } else {
+            stalled += 1;
+        }
+        if flips.len() > REPAIR_DIVERGENCE * best_flips.max(REPAIR_DIVERGENCE_FLOOR) {
+            break;
+        }
+    }
+    // Relaxation (only without the injective refinement).
+    let relax = options.refine.max_iterations == 0;
+    if relax && best_flips == 0 && round > 0 {
+        state.uv = best_uv.clone();
+        for _ in 0..16 {
+            for w in state.weights.iter_mut() {
+                *w = 1.0 + (*w - 1.0) * 0.85;
+            }
+            sys.refactor(&state.weights)?;
+            let mut trial = state.uv.clone();
+            let mut r_trial = state.r.clone();
+            let (_, e) = arap(sys, &state.weights, &state.pinned, &mut r_trial, &mut trial, options, 10, &mut |_| {})?;
+            if !folded_faces(mesh, sys, &trial, cone_angle).is_empty() {
+                break;
+            }
+            state.uv = trial;
+            state.r = r_trial;
+            state.energy = e;
+            best_uv = state.uv.clone();
+        }
+    }
+    Ok(Repaired { best_uv, best_flips, rounds: round, flips_before })
 }
 
 /// Untangles the folded map `start` (sec. [`super::untangle`]), preconditioned
