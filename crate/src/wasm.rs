@@ -167,9 +167,8 @@ impl MeshSession {
 
     /// Places cones with `feature_edges` (edge ids) as features.
     /// `progress(stage: string, step: number, remaining: number)` is called
-    /// per topology step, rounding round and cone-move pass. Returns
-    /// `{cones, boundary_corners, components, rounds, energy, phi_rms, timings,
-    /// feature_edges, free_boundary, inserted_vertices}` (cones on the mesh refined where the features need it).
+    /// per topology step, rounding round and cone-move pass. Returns a
+    /// [`ConeResult`] (cones on the mesh refined where the features need it).
     pub fn place_cones(
         &self,
         feature_edges: &[u32],
@@ -188,11 +187,9 @@ impl MeshSession {
 #[wasm_bindgen]
 impl MeshSession {
     /// Places cones and computes the seamless aligned map (the whole method).
-    /// Returns the `place_cones` fields plus `uv` (Float32Array, 2 per input
-    /// face corner `3 f + k`), `seam_edges` (input edge ids), `metrics`
-    /// (with `per_face_distortion`), `timings`, `inserted_vertices` (by the refinement), `glb`
-    /// (Uint8Array) and `obj` (string) of the solved mesh. Solve errors throw
-    /// as `solve_finish` says.
+    /// Returns a [`SolveResult`]: the `place_cones` fields plus the map, its
+    /// metrics and the exports of the solved mesh. Solve errors throw as
+    /// `solve_finish` says.
     pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool, progress: &Function) -> Result<JsValue, JsValue> {
         let schedule = self.solve_begin(feature_edges, alpha_smooth, miq)?;
         for c in schedule {

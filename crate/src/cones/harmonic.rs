@@ -12,6 +12,7 @@ use super::dual_tree::{orientation, DualTree};
 use super::dual_path::Visit;
 use crate::linalg::{LinalgError, SparseSpd, Triplet};
 use crate::mesh::{TriMesh, NONE};
+use crate::vec3::{cross, dot};
 
 /// Harmonic basis forms of one component, stored as CR values per face
 /// halfedge: `u[i][h]` is the value of `u_i` at the midpoint of halfedge `h`
@@ -182,7 +183,7 @@ fn gram_matrix(mesh: &TriMesh, tree: &DualTree, u: &[Vec<f64>]) -> Vec<Vec<f64>>
     for block in tree.faces.chunks(GRAM_BLOCK) {
         let mut b = nalgebra::DMatrix::<f64>::zeros(3 * block.len(), n_h);
         for (r, &f) in block.iter().enumerate() {
-            let s = face_area(mesh, f).sqrt();
+            let s = mesh.face_areas()[f as usize].sqrt();
             for (j, uj) in u.iter().enumerate() {
                 let g = cr_gradient(mesh, f, uj);
                 for k in 0..3 {
@@ -207,28 +208,18 @@ pub fn cr_gradient(mesh: &TriMesh, f: u32, u: &[f64]) -> [f64; 3] {
 /// Gradient in face `f` of the linear function with corner values `phi`.
 pub fn p1_gradient(mesh: &TriMesh, f: u32, phi: [f64; 3]) -> [f64; 3] {
     let hs = mesh.face_halfedges(f);
-    let n = {
-        let (a, b) = (mesh.halfedge_vector(hs[0]), mesh.halfedge_vector(hs[1]));
-        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-    };
-    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2]; // (2 area)^2
+    let n = cross(mesh.halfedge_vector(hs[0]), mesh.halfedge_vector(hs[1]));
+    let nn = dot(n, n); // (2 area)^2
     let mut g = [0.0; 3];
     for k in 0..3 {
         // grad lambda_k = n x e_k / (2A)^2 * |n| ... with e_k the edge opposite corner k.
         let e = mesh.halfedge_vector(hs[(k + 1) % 3]);
-        let c = [n[1] * e[2] - n[2] * e[1], n[2] * e[0] - n[0] * e[2], n[0] * e[1] - n[1] * e[0]];
+        let c = cross(n, e);
         for i in 0..3 {
             g[i] += phi[k] * c[i] / nn;
         }
     }
     g
-}
-
-fn face_area(mesh: &TriMesh, f: u32) -> f64 {
-    let hs = mesh.face_halfedges(f);
-    let (a, b) = (mesh.halfedge_vector(hs[0]), mesh.halfedge_vector(hs[1]));
-    let n = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-    0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
 }
 
 #[cfg(test)]
