@@ -145,9 +145,9 @@ fn run(args: &[String]) -> Result<(), Failure> {
                 return Ok(());
             }
             match name {
-                "info" => info(&parsed),
+                "info" => info_command(&parsed),
                 "cones" => cones_command(&parsed),
-                "solve" => solve(&parsed),
+                "solve" => solve_command(&parsed),
                 _ => unreachable!("command listed in COMMANDS without a handler"),
             }
         }
@@ -226,7 +226,7 @@ impl Args {
     }
 }
 
-fn info(args: &Args) -> Result<(), Failure> {
+fn info_command(args: &Args) -> Result<(), Failure> {
     let file = args.file()?;
     let raw = conemap::io::import_path(Path::new(file)).map_err(|e| Failure(e.to_string(), 1))?;
     let report = analyze(&raw);
@@ -492,7 +492,7 @@ fn print_cones(file: &str, mesh: &TriMesh, features: &FeatureSet, options: &Cone
 /// `solve`: import, cones, parametrization, export.
 /// `conemap solve`: read, place cones, parametrize, write the mesh with UVs
 /// (and the report when asked), print the summary.
-fn solve(args: &Args) -> Result<(), Failure> {
+fn solve_command(args: &Args) -> Result<(), Failure> {
     use conemap::export::{self, ExportInput, ExportOptions, Format};
     use conemap::mesh::RawMesh;
     use conemap::pipeline::{self, SolveOptions};

@@ -209,93 +209,18 @@ impl<'a> ComponentSystem<'a> {
         let cycles = vertex_cycles(mesh, &tree, &defect, &continuous);
         let BoundaryRows { fixed, pins } = peel_boundary(mesh, &tree, &cycles, boundary_k)?;
 
-        // Assemble.
         let n = nv + nh + ng;
         let h_scale = if weights.miq { 1.0 } else { HARMONIC_WEIGHT.sqrt() };
-        let (p0, h0) = (nv + nh, nv);
-        let mut a: Vec<Triplet> = Vec::new();
-        // L on the component's faces (in mesh order, as summed before).
-        let mut component_faces = tree.faces.clone();
-        component_faces.sort_unstable();
-        let l = mesh.cotan_laplacian_triplets(component_faces.iter().copied());
+        let l = component_laplacian(mesh, &tree);
         let laplacian: Vec<Triplet> = l
             .iter()
             .map(|&(r, c, w)| (local[r] as usize, local[c] as usize, w))
             .filter(|&(lr, lc, _)| lr <= lc)
             .collect();
-        let alpha = weights.alpha_smooth;
-        a.extend(laplacian.iter().map(|&(r, c, w)| (r, c, alpha * w)));
-        for i in 0..nv {
-            a.push((i, i, area[i] / total_area));
-        }
-        let h_weight = if weights.miq { alpha } else { 1.0 };
-        for i in 0..nh {
-            for j in i..nh {
-                a.push((h0 + i, h0 + j, h_weight * basis.gram[i][j]));
-            }
-        }
-        let objective_terms = a.clone();
-        // A tiny proximal term keeps the primal block definite (the matrix is
-        // then quasi-definite and LDLᵀ without pivoting is stable); it is a
-        // constant once every p is fixed, so final solutions are unaffected.
-        for g in 0..ng {
-            a.push((p0 + g, p0 + g, P_PROXIMAL));
-        }
-
-        let mut c: Vec<Triplet> = Vec::new();
-        let mut rhs: Vec<f64> = Vec::new();
-        let mut row = 0usize;
-        // Vertex rows (skip the last vertex: the rows sum to zero).
-        for &(r, col, w) in &l {
-            let (lr, lc) = (local[r], local[col]);
-            if lr != NONE && (lr as usize) + 1 < nv {
-                c.push((lr as usize, lc as usize, w));
-            }
-        }
-        for i in 0..nv.saturating_sub(1) {
-            for &(g, s) in &cycles[i].g {
-                c.push((i, p0 + g as usize, -FRAC_PI_2 * s as f64));
-            }
-            rhs.push(-cycles[i].transport);
-        }
-        row += nv.saturating_sub(1);
-        // Path rows.
-        let path_start = c.len();
-        let row_path = row;
-        for &e in &tree.leftovers {
-            let cycle = tree.fundamental_cycle(mesh, e);
-            for visit in &cycle {
-                let coef = segment_phi_coefficients(mesh, *visit);
-                let tri = mesh.faces()[(visit.h_in / 3) as usize];
-                for k in 0..3 {
-                    c.push((row, local[tri[k] as usize] as usize, coef[k]));
-                }
-            }
-            for j in 0..nh {
-                c.push((row, h0 + j, basis.path_integral(j, &cycle) / h_scale));
-            }
-            c.push((row, p0 + tree.g_index[e as usize] as usize, -FRAC_PI_2));
-            rhs.push(-cycle_transport(mesh, &cycle));
-            row += 1;
-        }
-        let path_rows: Vec<Triplet> = c[path_start..].iter().map(|&(r, col, w)| (r - row_path, col, w)).collect();
-        // Fix rows.
-        let row_fix = row;
-        for g in 0..ng {
-            c.push((row, p0 + g, if fixed[g].is_some() { 1.0 } else { 0.0 }));
-            rhs.push(fixed[g].unwrap_or(0) as f64);
-            row += 1;
-        }
-        // Pin rows.
-        for &(i, target) in &pins {
-            for &(g, s) in &cycles[i].g {
-                c.push((row, p0 + g as usize, s as f64));
-            }
-            rhs.push(target as f64);
-            row += 1;
-        }
-        let m = row;
-        let kkt = Kkt::assemble(&a, n, &c, m)?;
+        let objective_terms = objective_triplets(&laplacian, &area, total_area, &basis, weights);
+        let rows = ConstraintRows::assemble(mesh, &tree, &basis, &local, &l, &cycles, &fixed, &pins, h_scale);
+        let kkt = Kkt::assemble(&with_proximal(&objective_terms, nv + nh, ng), n, &rows.entries, rows.rhs.len())?;
+        let (p0, row_fix) = (nv + nh, rows.row_fix);
         let fix_slots = (0..ng)
             .map(|g| kkt.pattern.slot(p0 + g, n + row_fix + g).expect("fix entry is in the pattern"))
             .collect();
@@ -313,7 +238,7 @@ impl<'a> ComponentSystem<'a> {
             continuous,
             n,
             row_fix,
-            constraint_rhs: rhs,
+            constraint_rhs: rows.rhs,
             kkt,
             solver: None,
             solver_options: FactorOptions { max_refinement_steps: 50, ..FactorOptions::default() },
@@ -327,7 +252,7 @@ impl<'a> ComponentSystem<'a> {
             refinement_steps: 0,
             objective_terms,
             laplacian,
-            path_rows,
+            path_rows: rows.path_rows,
             curvature: None,
             free_curvature: None,
             free_curvature_failed: false,
@@ -427,7 +352,7 @@ impl<'a> ComponentSystem<'a> {
 
     /// Solves for `x` with the current fixes: by the curvature equation once
     /// every integer is fixed ([`Self::solve_fixed`]), else by the KKT.
-    pub(crate) fn solve(&mut self) -> Result<(), ConeError> {
+    pub(crate) fn solve_unknowns(&mut self) -> Result<(), ConeError> {
         if self.integers_fixed() {
             self.solve_fixed()
         } else {
@@ -578,7 +503,7 @@ impl<'a> ComponentSystem<'a> {
         // fixed, the curvature equation; else (free ports) a factorization
         // of the final matrix.
         if self.integers_fixed() || self.border.is_empty() {
-            self.solve()
+            self.solve_unknowns()
         } else {
             self.refactor_and_solve()
         }
@@ -753,6 +678,133 @@ pub(crate) fn test_system_free(mesh: &TriMesh) -> ComponentSystem<'_> {
     let boundary_k = crate::features::boundary_turning(mesh);
     let free: Vec<bool> = (0..mesh.n_edges() as u32).map(|e| mesh.is_boundary_edge(e)).collect();
     ComponentSystem::new(mesh, 0, &boundary_k, &free, Weights { alpha_smooth: 0.01, miq: false }).unwrap()
+}
+
+/// The cotangent Laplacian of the component of `tree` as triplets in mesh
+/// vertex indices, summed over its faces in mesh order.
+fn component_laplacian(mesh: &TriMesh, tree: &DualTree) -> Vec<Triplet> {
+    let mut faces = tree.faces.clone();
+    faces.sort_unstable();
+    mesh.cotan_laplacian_triplets(faces.iter().copied())
+}
+
+/// Upper-triangle triplets of the objective (eq. 18) on `[phi | h~]`:
+/// `alpha L + M/A` on phi (`laplacian` in local indices, upper triangle),
+/// the Gram matrix of the harmonic basis on `h~` (weight 1, or alpha for
+/// MIQ emulation).
+fn objective_triplets(laplacian: &[Triplet], area: &[f64], total_area: f64, basis: &HarmonicBasis, weights: Weights) -> Vec<Triplet> {
+    let (nv, nh) = (area.len(), basis.len());
+    let alpha = weights.alpha_smooth;
+    let mut a: Vec<Triplet> = laplacian.iter().map(|&(r, c, w)| (r, c, alpha * w)).collect();
+    a.extend(area.iter().enumerate().map(|(i, &ai)| (i, i, ai / total_area)));
+    let h_weight = if weights.miq { alpha } else { 1.0 };
+    for i in 0..nh {
+        for j in i..nh {
+            a.push((nv + i, nv + j, h_weight * basis.gram[i][j]));
+        }
+    }
+    a
+}
+
+/// The KKT's primal block: `objective` and a tiny proximal term on the `ng`
+/// integers from `p0`. It keeps the block definite (the matrix is then
+/// quasi-definite and LDLᵀ without pivoting is stable); it is a constant once
+/// every p is fixed, so final solutions are unaffected.
+fn with_proximal(objective: &[Triplet], p0: usize, ng: usize) -> Vec<Triplet> {
+    let mut a = objective.to_vec();
+    a.extend((0..ng).map(|g| (p0 + g, p0 + g, P_PROXIMAL)));
+    a
+}
+
+/// The constraint rows of eq. 16 in the order of the module doc (vertex,
+/// path, fix, pin), on the unknowns `[phi | h~ | p]`.
+struct ConstraintRows {
+    /// Row, column, value.
+    entries: Vec<Triplet>,
+    /// One right-hand side per row.
+    rhs: Vec<f64>,
+    /// The path rows' entries (rows counted from 0).
+    path_rows: Vec<Triplet>,
+    /// First fix row (one per `G` edge, inactive while its `p` is free).
+    row_fix: usize,
+}
+
+impl ConstraintRows {
+    /// All rows: `l` is the component's Laplacian in mesh indices, `local`
+    /// maps mesh to local vertices, `fixed` and `pins` come from
+    /// [`peel_boundary`], `h_scale` is `sqrt(W)` (1 for MIQ emulation).
+    #[allow(clippy::too_many_arguments)]
+    fn assemble(
+        mesh: &TriMesh,
+        tree: &DualTree,
+        basis: &HarmonicBasis,
+        local: &[u32],
+        l: &[Triplet],
+        cycles: &[VertexCycle],
+        fixed: &[Option<i64>],
+        pins: &[(usize, i64)],
+        h_scale: f64,
+    ) -> Self {
+        let mut rows = ConstraintRows { entries: Vec::new(), rhs: Vec::new(), path_rows: Vec::new(), row_fix: 0 };
+        let p0 = tree.vertices.len() + basis.len();
+        rows.push_vertex_rows(l, local, cycles, p0);
+        let (path_start, row_path) = (rows.entries.len(), rows.rhs.len());
+        rows.push_path_rows(mesh, tree, basis, local, p0, h_scale);
+        rows.path_rows = rows.entries[path_start..].iter().map(|&(r, col, w)| (r - row_path, col, w)).collect();
+        rows.row_fix = rows.rhs.len();
+        // Fix rows: `t_e p_e = t_e c_e`, `t_e = 1` where peeling fixed `p_e`.
+        for (g, f) in fixed.iter().enumerate() {
+            let row = rows.rhs.len();
+            rows.entries.push((row, p0 + g, if f.is_some() { 1.0 } else { 0.0 }));
+            rows.rhs.push(f.unwrap_or(0) as f64);
+        }
+        // Pin rows: `sum_e sigma_ve p_e = k_v - 4 j_v`.
+        for &(i, target) in pins {
+            let row = rows.rhs.len();
+            rows.entries.extend(cycles[i].g.iter().map(|&(g, s)| (row, p0 + g as usize, s as f64)));
+            rows.rhs.push(target as f64);
+        }
+        rows
+    }
+
+    /// Vertex rows `(L phi)_v - (pi/2) sum_e sigma_ve p_e = -transport(gamma_v)`
+    /// for every local vertex but the last (the rows sum to zero).
+    fn push_vertex_rows(&mut self, l: &[Triplet], local: &[u32], cycles: &[VertexCycle], p0: usize) {
+        let nv = cycles.len();
+        for &(r, col, w) in l {
+            let (lr, lc) = (local[r], local[col]);
+            if lr != NONE && (lr as usize) + 1 < nv {
+                self.entries.push((lr as usize, lc as usize, w));
+            }
+        }
+        for (i, cycle) in cycles.iter().enumerate().take(nv.saturating_sub(1)) {
+            self.entries.extend(cycle.g.iter().map(|&(g, s)| (i, p0 + g as usize, -FRAC_PI_2 * s as f64)));
+            self.rhs.push(-cycle.transport);
+        }
+    }
+
+    /// Path rows (`G_path`, one per leftover edge of the tree):
+    /// `B_phi phi + B_h h - (pi/2) p_l = -transport(C_l)` with eq. 11's
+    /// coefficients along the fundamental cycle and `h = h~ / h_scale`.
+    fn push_path_rows(&mut self, mesh: &TriMesh, tree: &DualTree, basis: &HarmonicBasis, local: &[u32], p0: usize, h_scale: f64) {
+        let h0 = tree.vertices.len();
+        for &e in &tree.leftovers {
+            let row = self.rhs.len();
+            let cycle = tree.fundamental_cycle(mesh, e);
+            for visit in &cycle {
+                let coef = segment_phi_coefficients(mesh, *visit);
+                let tri = mesh.faces()[(visit.h_in / 3) as usize];
+                for k in 0..3 {
+                    self.entries.push((row, local[tri[k] as usize] as usize, coef[k]));
+                }
+            }
+            for j in 0..basis.len() {
+                self.entries.push((row, h0 + j, basis.path_integral(j, &cycle) / h_scale));
+            }
+            self.entries.push((row, p0 + tree.g_index[e as usize] as usize, -FRAC_PI_2));
+            self.rhs.push(-cycle_transport(mesh, &cycle));
+        }
+    }
 }
 
 /// Per local vertex of the component of `tree`: its barycentric area (a third

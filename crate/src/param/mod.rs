@@ -117,7 +117,7 @@ pub struct Parametrization {
     pub timings: ParamTimings,
 }
 
-/// What the stages of the seamless solve ([`seamless::solve`]) ran and repaired.
+/// What the stages of the seamless solve ([`seamless::seamless_map`]) ran and repaired.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct ParamCounts {
     /// ARAP iterations run (after the Poisson solve).
@@ -235,7 +235,7 @@ pub fn parametrize(
     let cut = cut_graph::cut_graph(mesh, placement, &field)?;
     timings.cut = clock.lap();
 
-    let result = seamless::solve(mesh, placement, &field, &cut, options, progress, &mut clock, &mut timings)?;
+    let result = seamless::seamless_map(mesh, placement, &field, &cut, options, progress, &mut clock, &mut timings)?;
     let uv: Vec<[f64; 2]> = (0..3 * mesh.n_faces()).map(|c| result.uv[cut.wedge[c] as usize]).collect();
     if uv.iter().any(|p| !p[0].is_finite() || !p[1].is_finite()) {
         return Err(ParamError::NotFinite { what: "uv" });

@@ -41,7 +41,7 @@ const ARAP_TOLERANCE: f64 = 1e-5;
 /// `max |C x| / max |x|` every solve is projected down to.
 const CONSTRAINT_TOLERANCE: f64 = 1e-14;
 
-/// Result of [`solve`]: UV per wedge.
+/// Result of [`seamless_map`]: UV per wedge.
 #[derive(Clone, Debug)]
 pub struct SeamlessResult {
     pub uv: Vec<[f64; 2]>,
@@ -100,7 +100,7 @@ impl System {
     /// Global step: solves (23) for the target rotations `r` (rows in the
     /// face frame) to the relative residual `tolerance`, then projects onto
     /// the constraints (to [`CONSTRAINT_TOLERANCE`] of the largest unknown).
-    fn solve(&self, weights: &[f64], r: &[[[f64; 2]; 2]], tolerance: f64) -> Result<Vec<[f64; 2]>, ParamError> {
+    fn global_step(&self, weights: &[f64], r: &[[[f64; 2]; 2]], tolerance: f64) -> Result<Vec<[f64; 2]>, ParamError> {
         let mut rhs = vec![0.0; self.n_unknowns + self.n_rows];
         for ((el, &wt), rf) in self.elements.iter().zip(weights).zip(r) {
             for k in 0..3 {
@@ -301,7 +301,7 @@ impl System {
 /// fold-free map (no flipped triangle, no wound vertex) is found the result
 /// is fold-free and no worse by eq. (19) than that map.
 #[allow(clippy::too_many_arguments)]
-pub fn solve(
+pub fn seamless_map(
     mesh: &TriMesh,
     placement: &ConePlacement,
     field: &CrossField,
@@ -318,7 +318,7 @@ pub fn solve(
 
     // Poisson (23) with the field's target Jacobians (B.1).
     let mut r: Vec<[[f64; 2]; 2]> = (0..nf).map(|f| field.target(f)).collect();
-    let mut uv = sys.solve(&weights, &r, POISSON_TOLERANCE)?;
+    let mut uv = sys.global_step(&weights, &r, POISSON_TOLERANCE)?;
     let poisson_uv = uv.clone();
     timings.poisson = clock.lap();
 
@@ -589,7 +589,7 @@ fn arap(
             }
         }
         // Global step: (23) with the new R, same factorization.
-        *uv = sys.solve(weights, r, ARAP_TOLERANCE)?;
+        *uv = sys.global_step(weights, r, ARAP_TOLERANCE)?;
         prev = prev.min(e);
         e = energy(r, uv);
         if prev.is_finite() && (prev - e) <= options.arap_tolerance * prev.max(f64::MIN_POSITIVE) {

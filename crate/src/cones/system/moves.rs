@@ -318,7 +318,7 @@ impl ComponentSystem<'_> {
                 break;
             }
         }
-        self.solve()?;
+        self.solve_unknowns()?;
         Ok(moves)
     }
 
@@ -359,7 +359,7 @@ impl ComponentSystem<'_> {
             moved += 1;
         }
         if moved > 0 {
-            self.solve()?;
+            self.solve_unknowns()?;
         }
         Ok(moved)
     }
@@ -429,7 +429,7 @@ impl ComponentSystem<'_> {
                 rejected.insert((t.1, t.0));
             }
         }
-        self.solve()?;
+        self.solve_unknowns()?;
         Ok(merged)
     }
 
@@ -492,7 +492,7 @@ impl ComponentSystem<'_> {
                 None => break,
             }
         }
-        self.solve()?;
+        self.solve_unknowns()?;
         Ok(removed)
     }
 }
