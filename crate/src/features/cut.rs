@@ -21,12 +21,6 @@ pub struct CutMesh {
 }
 
 impl CutMesh {
-    /// True when boundary edge `e` of the cut mesh comes from a feature
-    /// (rather than from a boundary of the original mesh).
-    pub fn is_feature_edge(&self, original: &TriMesh, e: u32) -> bool {
-        self.mesh.is_boundary_edge(e) && !original.is_boundary_edge(self.original_edge[e as usize])
-    }
-
     /// Frees the boundary of the original mesh (feature edges stay aligned).
     pub fn free_original_boundary(&mut self, original: &TriMesh) {
         self.free = (0..self.mesh.n_edges() as u32)

@@ -463,12 +463,6 @@ impl<K> SparseCholesky<K> {
         self.core.factorize(values)
     }
 
-    /// [`Self::factorize`] from triplets (same convention as [`SymmetricPattern`]).
-    pub fn factorize_triplets(&mut self, triplets: &[Triplet]) -> Result<(), LinalgError> {
-        let v = self.core.pattern.values_from_triplets(triplets)?;
-        self.core.factorize(&v)
-    }
-
     /// Solves with the (regularized) factor alone: no refinement and no
     /// residual, for callers that refine against a matrix of their own.
     /// Errors if not factorized, on a bad length or on non-finite values.
