@@ -14,7 +14,6 @@
 pub mod clock;
 pub mod cones;
 pub mod export;
-pub mod error;
 pub mod features;
 pub mod io;
 pub mod linalg;
@@ -26,5 +25,6 @@ pub mod param;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 
-pub use error::{ImportError, Problem};
+pub use io::ImportError;
+pub use mesh::Problem;
 pub use mesh::{MeshReport, RawMesh, TriMesh};

@@ -17,11 +17,12 @@ pub mod system;
 pub(crate) mod test_meshes;
 
 use crate::clock::Stopwatch;
+use crate::linalg::LinalgError;
 use crate::features::{CutMesh, FeatureSet};
 use crate::mesh::TriMesh;
 pub use problem::{ComponentPlacement, ConeProblem, MismatchError};
 use serde::{Deserialize, Serialize};
-pub use system::ConeError;
+use std::fmt;
 
 /// Default `alpha_smooth` (paper: 0.01 in most figures).
 pub const DEFAULT_ALPHA: f64 = 0.01;
@@ -101,6 +102,40 @@ impl Default for ConeOptions {
             coarse_vertices: COARSE_VERTICES,
             rounding: RoundingRule::PerCluster,
             boundary: BoundaryMode::Aligned,
+        }
+    }
+}
+
+/// What went wrong while placing cones.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConeError {
+    Solve(LinalgError),
+    /// The boundary turning integers admit no integer path values (an internal inconsistency).
+    InconsistentBoundary { vertex: u32 },
+}
+
+impl From<LinalgError> for ConeError {
+    fn from(e: LinalgError) -> Self {
+        ConeError::Solve(e)
+    }
+}
+
+impl fmt::Display for ConeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ConeError::Solve(e) => write!(f, "cone placement: linear solve failed: {e}"),
+            ConeError::InconsistentBoundary { vertex } => {
+                write!(f, "cone placement: boundary turning at vertex v{vertex} is inconsistent")
+            }
+        }
+    }
+}
+
+impl std::error::Error for ConeError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ConeError::Solve(e) => Some(e),
+            ConeError::InconsistentBoundary { .. } => None,
         }
     }
 }

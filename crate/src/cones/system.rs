@@ -19,7 +19,7 @@
 use super::dual_tree::{is_free_edge, DualTree};
 use super::dual_path::{cycle_transport, segment_phi_coefficients, vertex_cycle, Visit};
 use super::harmonic::HarmonicBasis;
-use super::RoundingRule;
+use super::{ConeError, RoundingRule};
 use crate::linalg::{FixBorder, Kkt, LdltSolver, LinalgError, FactorOptions, Triplet};
 use crate::mesh::{TriMesh, NONE};
 use std::f64::consts::FRAC_PI_2;
@@ -145,40 +145,6 @@ pub struct ComponentSystem<'a> {
     free_curvature_failed: bool,
     /// How [`Self::round_all`] batches its fixes.
     pub rounding: RoundingRule,
-}
-
-/// What went wrong while placing cones.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ConeError {
-    Solve(LinalgError),
-    /// The boundary turning integers admit no integer path values (an internal inconsistency).
-    InconsistentBoundary { vertex: u32 },
-}
-
-impl From<LinalgError> for ConeError {
-    fn from(e: LinalgError) -> Self {
-        ConeError::Solve(e)
-    }
-}
-
-impl std::fmt::Display for ConeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ConeError::Solve(e) => write!(f, "cone placement: linear solve failed: {e}"),
-            ConeError::InconsistentBoundary { vertex } => {
-                write!(f, "cone placement: boundary turning at vertex v{vertex} is inconsistent")
-            }
-        }
-    }
-}
-
-impl std::error::Error for ConeError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            ConeError::Solve(e) => Some(e),
-            ConeError::InconsistentBoundary { .. } => None,
-        }
-    }
 }
 
 impl<'a> ComponentSystem<'a> {

@@ -1,10 +1,12 @@
 //! File import: bytes in, [`RawMesh`] out. The format is picked from the
 //! file name's extension, falling back to the first bytes.
 
+mod error;
 pub mod gltf;
 pub mod obj;
 
-use crate::{ImportError, RawMesh};
+pub use error::ImportError;
+use crate::RawMesh;
 
 /// A file handed to the importer: its name (used for the format and for
 /// resolving relative URIs) and its bytes.

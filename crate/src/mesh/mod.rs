@@ -9,6 +9,7 @@
 
 mod decimate;
 mod geometry;
+mod problem;
 mod raw;
 pub mod shapes;
 mod subdivide;
@@ -22,6 +23,7 @@ mod tests;
 
 pub use decimate::{decimate_interior, Decimated};
 pub use geometry::{wrap_angle, FaceFrames};
+pub use problem::Problem;
 pub use raw::RawMesh;
 pub use subdivide::subdivide_midpoint;
 pub use trimesh::{Outgoing, TriMesh, NONE};
