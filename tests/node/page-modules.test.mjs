@@ -1,5 +1,5 @@
 // Unit tests of the page's pure modules (web/src/topology.ts, features.ts,
-// solve-view.ts): each is bundled by esbuild to an ES module and imported, so
+// solve-view.ts, state.ts, dom.ts): each is bundled by esbuild to an ES module and imported, so
 // the tests run the page's code itself, without a browser.
 import { before, describe, it } from 'node:test';
 import assert from 'node:assert/strict';
@@ -168,5 +168,163 @@ describe('solve-view.ts', () => {
       const checker = sv.checkerUv(uv);
       assert.equal(Math.max(...checker) - Math.min(...checker), 2.5);
     }
+  });
+});
+
+describe('state.ts', () => {
+  let st;
+  before(async () => { st = await load('state'); });
+
+  /** A store driven through `phases` from idle (a load first), and the phases its subscriber saw. */
+  function driven(...phases) {
+    const store = new st.PageStore();
+    const seen = [];
+    store.subscribe((s) => seen.push(s.phase));
+    store.beginLoad();
+    for (const p of phases) store.transition(p);
+    return { store, seen };
+  }
+
+  it('starts idle and tells a new subscriber the state at once', () => {
+    const store = new st.PageStore();
+    const seen = [];
+    store.subscribe((s) => seen.push(s));
+    assert.equal(seen.length, 1);
+    assert.equal(seen[0].phase, 'idle');
+    assert.equal(seen[0].load, 0);
+    assert.equal(seen[0].building, false);
+  });
+
+  it('goes through a load and solves, notifying every change with the new state', () => {
+    const { store, seen } = driven('ready', 'solving', 'solved', 'solving', 'ready', 'loading', 'error', 'solving', 'solved');
+    assert.deepEqual(seen, ['idle', 'loading', 'ready', 'solving', 'solved', 'solving', 'ready', 'loading', 'error', 'solving', 'solved']);
+    assert.equal(store.state.phase, 'solved');
+  });
+
+  it('rejects transitions that make no sense, keeping the state and telling nobody', () => {
+    // Each path starts with a load: [] is the phase loading.
+    const bad = [
+      [[], 'solved'], [[], 'solving'], [[], 'idle'],
+      [['ready'], 'solved'], [['ready'], 'error'], [['ready'], 'idle'],
+      [['ready', 'solving'], 'loading'], [['ready', 'solving'], 'error'], [['ready', 'solving'], 'idle'],
+      [['error'], 'ready'], [['error'], 'solved'],
+    ];
+    for (const [path, to] of bad) {
+      const { store, seen } = driven(...path);
+      const before = store.state;
+      const notified = seen.length;
+      assert.throws(() => store.transition(to), st.InvalidTransition, `${[...path, to].join(' -> ')}`);
+      assert.equal(store.state, before, 'state unchanged');
+      assert.equal(seen.length, notified, 'no notification');
+    }
+    // From idle only a load may start.
+    const idle = new st.PageStore();
+    for (const to of ['idle', 'ready', 'solving', 'solved', 'error']) assert.throws(() => idle.transition(to), st.InvalidTransition);
+    assert.equal(idle.state.phase, 'idle');
+    // canTransition answers from the same table.
+    assert.equal(st.canTransition('ready', 'solving'), true);
+    assert.equal(st.canTransition('solved', 'solving'), true);
+    assert.equal(st.canTransition('idle', 'solved'), false);
+    assert.equal(st.canTransition('loading', 'solving'), false);
+  });
+
+  it('marks building only within a solve, and clears it on leaving', () => {
+    const { store } = driven('ready', 'solving');
+    store.transition('solving', { building: true });
+    assert.equal(store.state.building, true);
+    assert.equal(store.state.phase, 'solving');
+    store.transition('solved');
+    assert.equal(store.state.building, false);
+    assert.throws(() => store.transition('loading', { building: true }), st.InvalidTransition);
+    assert.equal(store.state.phase, 'solved');
+  });
+
+  it('makes earlier load tokens stale with every load', () => {
+    const store = new st.PageStore();
+    const first = store.beginLoad();
+    assert.ok(store.isCurrentLoad(first));
+    const second = store.beginLoad(); // loading -> loading: a later load supersedes
+    assert.notEqual(first, second);
+    assert.equal(store.isCurrentLoad(first), false);
+    assert.ok(store.isCurrentLoad(second));
+    store.transition('ready');
+    assert.ok(store.isCurrentLoad(second), 'finishing a load keeps its token');
+    // A load cannot begin in the middle of a solve (the solve is ended first).
+    store.transition('solving');
+    assert.throws(() => store.beginLoad(), st.InvalidTransition);
+    assert.ok(store.isCurrentLoad(second), 'a rejected load takes no token');
+  });
+
+  it('keeps the solve tuning, changed field by field, in new state objects', () => {
+    const store = new st.PageStore();
+    const seen = [];
+    store.subscribe((s) => seen.push(s));
+    const initial = store.state;
+    assert.deepEqual({ ...initial.tuning }, { helperMinFaces: 50_000, helperWait: false, maxConeRefinements: undefined });
+    store.setTuning({ helperMinFaces: 0, helperWait: true });
+    store.setTuning({ maxConeRefinements: 0 });
+    assert.deepEqual({ ...store.state.tuning }, { helperMinFaces: 0, helperWait: true, maxConeRefinements: 0 });
+    assert.equal(initial.tuning.helperMinFaces, 50_000, 'an earlier state is not changed');
+    assert.equal(seen.length, 3);
+    assert.notEqual(seen[1], seen[2]);
+  });
+
+  it('stops notifying after unsubscribe, and mirrors the phase into a dataset', () => {
+    const store = new st.PageStore();
+    const seen = [];
+    const off = store.subscribe((s) => seen.push(s.phase));
+    const dataset = {};
+    st.mirrorToDataset(store, dataset);
+    assert.deepEqual(dataset, { state: 'idle' });
+    store.beginLoad();
+    off();
+    store.transition('ready');
+    assert.deepEqual(seen, ['idle', 'loading']);
+    assert.deepEqual(dataset, { state: 'ready' });
+    store.transition('solving');
+    assert.deepEqual(dataset, { state: 'solving', solving: 'true' });
+    store.transition('solved');
+    assert.deepEqual(dataset, { state: 'solved' }, 'solving is removed, not left false');
+  });
+});
+
+describe('dom.ts', () => {
+  let dom;
+  before(async () => { dom = await load('dom'); });
+
+  it('formats numbers with fixed decimals, exponential at the extremes, a dash when not finite', () => {
+    assert.equal(dom.fmt(1.23456), '1.235');
+    assert.equal(dom.fmt(1.23456, 1), '1.2');
+    assert.equal(dom.fmt(0), '0.000');
+    assert.equal(dom.fmt(9999.5, 0), '10000', 'below 1e4 stays fixed');
+    assert.equal(dom.fmt(12345.678), '1.23e+4');
+    assert.equal(dom.fmt(-0.0001234), '-1.23e-4');
+    assert.equal(dom.fmt(0.001), '0.001', '1e-3 itself stays fixed');
+    for (const x of [NaN, Infinity, -Infinity]) assert.equal(dom.fmt(x), '—');
+  });
+
+  it('formats counts with separators, a dash for a missing one', () => {
+    assert.equal(dom.fmtInt(1234567), '1,234,567');
+    assert.equal(dom.fmtInt(0), '0');
+    assert.equal(dom.fmtInt(undefined), '—');
+  });
+
+  it('formats sizes in B, KB and MB, and durations in whole ms', () => {
+    assert.equal(dom.fmtBytes(0), '0 B');
+    assert.equal(dom.fmtBytes(1023), '1023 B');
+    assert.equal(dom.fmtBytes(1024), '1.0 KB');
+    assert.equal(dom.fmtBytes(1536), '1.5 KB');
+    assert.equal(dom.fmtBytes(1024 ** 2 - 1), '1024.0 KB');
+    assert.equal(dom.fmtBytes(5.25 * 1024 ** 2), '5.3 MB');
+    assert.equal(dom.fmtMs(12.4), '12 ms');
+    assert.equal(dom.fmtMs(12.6), '13 ms');
+    assert.equal(dom.fmtMs(0), '0 ms');
+  });
+
+  it('keys table rows in kebab case', () => {
+    assert.equal(dom.statKey('Cones'), 'cones');
+    assert.equal(dom.statKey('Σk (cones + corners)'), 'k-cones-corners');
+    assert.equal(dom.statKey('Faces < 0.2 / < 0.3'), 'faces-0-2-0-3');
+    assert.equal(dom.statKey('Time: cones total'), 'time-cones-total');
   });
 });

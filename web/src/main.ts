@@ -1,62 +1,25 @@
-// Page entry: wires the file inputs, the samples menu, the worker and the viewer;
-// the feature editor and the solve controls live in editor.ts.
-import { Editor, type EditorHooks } from './editor';
+// Page entry: wires the file inputs, the samples menu, the worker and the viewer
+// to the page's state (state.ts); the feature editor, the solve controls and
+// the results are put together in editor.ts.
+import { $, fmtBytes, fmtInt, fmtMs } from './dom';
+import { Editor } from './editor';
 import { fetchFile, orderFiles, readFiles } from './files';
-import { Panels, type Sample, type Stats, fmtBytes } from './panels';
+import { Panels, type Sample, type Stats } from './panels';
 import type { Stage, WireFile } from './protocol';
+import { PageStore, mirrorToDataset } from './state';
+import { installHooks } from './test-hooks';
 import { Viewer } from './viewer';
 import { MeshWorker } from './worker-client';
 
-type State = 'idle' | 'loading' | 'ready' | 'error' | 'solving' | 'solved';
-
-/** Test hooks (read by tests/e2e and scripts/bench.mjs); the editor keeps its part up to date. */
-interface Hooks extends EditorHooks {
-  state: State;
-  stats: (Omit<Stats, 'report'> & Partial<NonNullable<Stats['report']>>) | null;
-  lastError: string | null;
-  version: string | null;
-  workerRestarts: number;
-  /** Increments on every finished load (success or failure). */
-  loads: number;
-  /** Milliseconds of the last load's phases on the main thread's clock. */
-  timings: { read: number; worker: number; draw: number } | null;
-}
-declare global {
-  interface Window {
-    __conemap: Hooks;
-    /** Test-only actions (tests/e2e). */
-    __conemapTest: {
-      importWithTrap(name: string, text: string): void;
-      /** Page position of the midpoint of edge `edgeId` (client CSS px). */
-      projectEdge(edgeId: number): { x: number; y: number } | null;
-      /** An interior, unmarked edge whose midpoint is visible and picks back to itself; -1 if none. */
-      visibleEdge(): number;
-      /** Edge id a click at (x, y) would toggle; -1 when none. */
-      edgeAt(x: number, y: number): number;
-      /** Smallest mesh (faces) whose solves use a helper worker; `wait`: start placing once it is ready. */
-      setHelper(minFaces: number, wait: boolean): void;
-      /** Refinements around cones of angle 0 before a solve fails (undefined: the default; 0 shows the raw placement's error). */
-      setMaxConeRefinements(n: number | undefined): void;
-      /** Position of vertex `v` of the open mesh, its page position (client CSS px), the end vertices of edge `e`. */
-      vertexPosition(v: number): [number, number, number] | null;
-      projectVertex(v: number): { x: number; y: number } | null;
-      edgeEnds(e: number): [number, number] | null;
-    };
-  }
-}
-
 const DEFAULT_SAMPLE = 'fandisk.obj';
-const hooks: Hooks = {
-  state: 'idle', stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
-  features: 0, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
-};
-window.__conemap = hooks;
-document.body.dataset['state'] = hooks.state;
+const store = new PageStore();
+const hooks = installHooks(store);
+mirrorToDataset(store, document.body.dataset);
 
 const panels = new Panels();
-const viewer = new Viewer(document.getElementById('viewport')!);
+const viewer = new Viewer($('viewport'));
 const worker = new MeshWorker();
-const editor = new Editor(viewer, worker, hooks, setState);
+const editor = new Editor(viewer, worker, store, hooks);
 
 const stageText: Record<Stage, string> = {
   starting: 'Starting the importer',
@@ -65,23 +28,15 @@ const stageText: Record<Stage, string> = {
   transferring: 'Transferring',
 };
 
-function setState(state: State): void {
-  hooks.state = state;
-  document.body.dataset['state'] = state;
-}
-
-let current = 0;
-
 /** Runs one load: read bytes → import in the worker → draw. Later loads supersede earlier ones. */
 async function load(
   label: string,
   read: (progress: (loaded: number, total: number) => void) => Promise<WireFile[]>,
   simulateTrap = false,
 ): Promise<void> {
-  const token = ++current;
-  const live = (): boolean => token === current;
-  editor.cancelSolve(); // a new mesh supersedes a running solve
-  setState('loading');
+  editor.solve.cancel(); // a new mesh supersedes a running solve
+  const token = store.beginLoad();
+  const live = (): boolean => store.isCurrentLoad(token);
   panels.clearError();
   panels.setStatus(`Reading ${label}…`, true, 0);
   try {
@@ -100,7 +55,7 @@ async function load(
     panels.setStatus(`Drawing ${label}…`, true);
     viewer.show(result);
     editor.setMesh(result, label);
-    viewer.renderNow();
+    viewer.loop.renderNow(); // drawn before "ready" (and before screenshots)
     hooks.timings = { read: t0 - tRead, worker: tDraw - t0, draw: performance.now() - tDraw };
     const stats: Stats = {
       file: label,
@@ -115,11 +70,11 @@ async function load(
     hooks.stats = { ...plain, ...(report ?? {}) };
     hooks.version = result.version;
     hooks.lastError = null;
-    document.getElementById('version')!.textContent = `v${result.version}`;
+    $('version').textContent = `v${result.version}`;
     updateWireframeToggle();
     const total = performance.now() - t0;
-    panels.setStatus(`Loaded ${label}: ${stats.faces.toLocaleString('en-US')} faces in ${total.toFixed(0)} ms`, false);
-    setState('ready');
+    panels.setStatus(`Loaded ${label}: ${fmtInt(stats.faces)} faces in ${fmtMs(total)}`, false);
+    store.transition('ready');
   } catch (e) {
     if (!live()) return;
     const message = e instanceof Error ? e.message : String(e);
@@ -127,7 +82,7 @@ async function load(
     console.warn(`conemap: could not load ${label}: ${message}`);
     panels.showError(label, message);
     panels.setStatus(viewer.hasMesh ? 'Import failed; the previous mesh is still shown.' : 'Import failed.', false);
-    setState('error');
+    store.transition('error');
   } finally {
     hooks.workerRestarts = worker.restarts;
     if (live()) hooks.loads++;
@@ -147,14 +102,14 @@ function loadSample(file: string): void {
 }
 
 // File picker.
-const input = document.getElementById('file-input') as HTMLInputElement;
+const input = $<HTMLInputElement>('file-input');
 input.addEventListener('change', () => {
   if (input.files) loadLocal(input.files);
   input.value = ''; // choosing the same file again still fires `change`
 });
 
 // Drop anywhere.
-const overlay = document.getElementById('drop-overlay')!;
+const overlay = $('drop-overlay');
 let dragDepth = 0;
 const hasFiles = (e: DragEvent): boolean => [...(e.dataTransfer?.types ?? [])].includes('Files');
 window.addEventListener('dragenter', (e) => {
@@ -194,31 +149,26 @@ async function listSamples(): Promise<void> {
 }
 
 // View options.
-const wireToggle = document.getElementById('wireframe-toggle') as HTMLInputElement;
+const wireToggle = $<HTMLInputElement>('wireframe-toggle');
 wireToggle.addEventListener('change', () => viewer.setWireframe(wireToggle.checked));
 function updateWireframeToggle(): void {
   wireToggle.disabled = !viewer.wireframeAvailable;
   wireToggle.parentElement!.title = viewer.wireframeAvailable ? '' : 'Edge overlay is off for very large meshes';
 }
-document.getElementById('frame-button')!.addEventListener('click', () => viewer.frame());
+$('frame-button').addEventListener('click', () => viewer.frame());
 
 window.__conemapTest = {
   importWithTrap(name, text) {
     void load(name, async () => [{ name, bytes: new TextEncoder().encode(text).buffer as ArrayBuffer }], true);
   },
-  projectEdge: (e) => editor.projectEdge(e),
-  visibleEdge: () => editor.visibleEdge(),
-  edgeAt: (x, y) => editor.edgeAt(x, y),
-  setHelper: (minFaces, wait) => {
-    MeshWorker.helperMinFaces = minFaces;
-    MeshWorker.helperWait = wait;
-  },
-  setMaxConeRefinements: (n) => {
-    MeshWorker.maxConeRefinements = n;
-  },
-  vertexPosition: (v) => editor.vertexPosition(v),
-  projectVertex: (v) => editor.projectVertex(v),
-  edgeEnds: (e) => editor.edgeEnds(e),
+  projectEdge: (e) => editor.features.projectEdge(e),
+  visibleEdge: () => editor.features.visibleEdge(),
+  edgeAt: (x, y) => editor.features.edgeAt(x, y),
+  setHelper: (minFaces, wait) => store.setTuning({ helperMinFaces: minFaces, helperWait: wait }),
+  setMaxConeRefinements: (n) => store.setTuning({ maxConeRefinements: n }),
+  vertexPosition: (v) => editor.features.vertexPosition(v),
+  projectVertex: (v) => editor.features.projectVertex(v),
+  edgeEnds: (e) => editor.features.edgeEnds(e),
 };
 
 void listSamples();

@@ -1,12 +1,7 @@
 // The left panel: status line with progress, error box, stats table, problems
 // list, samples menu. Pure DOM; no knowledge of the worker or the viewer.
+import { $, definitionList, fmtBytes, fmtInt, fmtMs } from './dom';
 import type { MeshReport } from './protocol';
-
-const $ = <T extends HTMLElement>(id: string): T => {
-  const el = document.getElementById(id);
-  if (!el) throw new Error(`#${id} missing from index.html`);
-  return el as T;
-};
 
 export interface Stats {
   file: string;
@@ -24,29 +19,11 @@ export interface Sample {
   note?: string;
 }
 
-const fmtInt = (n: number | undefined): string => (typeof n === 'number' ? n.toLocaleString('en-US') : '—');
-export const fmtBytes = (n: number): string =>
-  n < 1024 ? `${n} B` : n < 1024 ** 2 ? `${(n / 1024).toFixed(1)} KB` : `${(n / 1024 ** 2).toFixed(1)} MB`;
-
 /** Genus per component; '—' where the component is not manifold (genus undefined there). */
 function genusText(r: MeshReport): string {
   if (!r.genus?.length) return '—';
   const shown = r.genus.slice(0, 8).map((g, i) => (r.component_is_manifold?.[i] === false ? '—' : String(g)));
   return shown.join(', ') + (r.genus.length > shown.length ? ', …' : '');
-}
-
-/** A two-column table of figures; each value carries `data-stat` (its key in kebab case). */
-export function definitionList(rows: Array<[string, string]>): HTMLDListElement {
-  const table = document.createElement('dl');
-  for (const [k, v] of rows) {
-    const dt = document.createElement('dt');
-    dt.textContent = k;
-    const dd = document.createElement('dd');
-    dd.textContent = v;
-    dd.dataset['stat'] = k.toLowerCase().replace(/[^a-z0-9]+/g, '-').replace(/^-|-$/g, '');
-    table.append(dt, dd);
-  }
-  return table;
 }
 
 export class Panels {
@@ -111,7 +88,7 @@ export class Panels {
       ];
       for (const [k, v] of optional) if (typeof v === 'number') rows.push([k, fmtInt(v)]);
     }
-    rows.push(['Import time', `${s.importMs.toFixed(0)} ms`]);
+    rows.push(['Import time', fmtMs(s.importMs)]);
     this.stats.replaceChildren(definitionList(rows));
     this.showProblems(r);
   }

@@ -3,7 +3,8 @@
 // known, with the hovered face highlighted in sync with the 3D view.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { RenderScheduler, checkerTexture, createRenderer, precompile } from './viewer';
+import { COLORS, checkerTexture } from './palette';
+import { RenderLoop, createRenderer, latestPerFrame } from './render-loop';
 
 /** A UV layout to show (see `SolveView` in protocol.ts); the arrays are used as they are (not copied). */
 export interface UvLayout {
@@ -36,35 +37,30 @@ export class UvView {
   private uv: Float32Array | null = null;
   private readonly raycaster = new THREE.Raycaster();
   private bounds = new THREE.Box2();
+  /** Draws the layout on request (see `RenderLoop`). */
+  readonly loop: RenderLoop;
   /** Called with the face under the pointer (null when none). */
   onHover: ((face: number | null) => void) | null = null;
 
   constructor(private readonly container: HTMLElement) {
     this.renderer = createRenderer(container, 'uv-canvas');
+    this.loop = new RenderLoop(this.renderer, this.scene, this.camera);
     this.scene.background = new THREE.Color(0x20252d);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.enableRotate = false;
     this.controls.screenSpacePanning = true;
     this.controls.mouseButtons = { LEFT: THREE.MOUSE.PAN, MIDDLE: THREE.MOUSE.DOLLY, RIGHT: THREE.MOUSE.PAN };
-    this.controls.addEventListener('change', () => this.requestRender());
+    this.controls.addEventListener('change', () => this.loop.request());
     const hg = new THREE.BufferGeometry();
     hg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3));
-    this.hover = new THREE.Mesh(hg, new THREE.MeshBasicMaterial({ color: 0xfff275, side: THREE.DoubleSide, depthTest: false }));
+    this.hover = new THREE.Mesh(hg, new THREE.MeshBasicMaterial({ color: COLORS.hover, side: THREE.DoubleSide, depthTest: false }));
     this.hover.visible = false;
     this.hover.renderOrder = 3;
     this.scene.add(this.hover);
 
-    let pending: PointerEvent | null = null;
+    const hoverAt = latestPerFrame((e: PointerEvent) => this.onHover?.(this.pick(e.clientX, e.clientY)));
     this.renderer.domElement.addEventListener('pointermove', (e) => {
-      if (e.buttons) return;
-      if (!pending) {
-        requestAnimationFrame(() => {
-          const ev = pending!;
-          pending = null;
-          this.onHover?.(this.pick(ev.clientX, ev.clientY));
-        });
-      }
-      pending = e;
+      if (!e.buttons) hoverAt(e);
     });
     this.renderer.domElement.addEventListener('pointerleave', () => this.onHover?.(null));
     new ResizeObserver(() => this.resized()).observe(container);
@@ -79,7 +75,7 @@ export class UvView {
     m.map = on && has ? null : (this.checker ??= checkerTexture());
     m.color.setHex(0xffffff);
     m.needsUpdate = true;
-    this.requestRender();
+    this.loop.request();
   }
 
   /** Shows a layout (its triangles, the chart outlines, and triangle outlines when small) and frames it. */
@@ -102,7 +98,7 @@ export class UvView {
     if (layout.outline.length) {
       const sg = new THREE.BufferGeometry();
       sg.setAttribute('position', new THREE.BufferAttribute(layout.outline, 3));
-      this.seams = new THREE.LineSegments(sg, new THREE.LineBasicMaterial({ color: 0xff4fa3 }));
+      this.seams = new THREE.LineSegments(sg, new THREE.LineBasicMaterial({ color: COLORS.seam }));
       this.seams.renderOrder = 2;
       this.scene.add(this.seams);
     }
@@ -136,7 +132,7 @@ export class UvView {
     this.seams = null;
     this.uv = null;
     this.hover.visible = false;
-    this.requestRender();
+    this.loop.request();
   }
 
   frame(): void {
@@ -163,7 +159,7 @@ export class UvView {
       this.hover.geometry.computeBoundingSphere();
       this.hover.visible = true;
     }
-    this.requestRender();
+    this.loop.request();
   }
 
   private pick(clientX: number, clientY: number): number | null {
@@ -206,20 +202,6 @@ export class UvView {
     this.camera.position.x = c.x;
     this.camera.position.y = c.y;
     this.camera.updateProjectionMatrix();
-    this.requestRender();
-  }
-
-  private readonly scheduler = new RenderScheduler(() => this.renderNow());
-
-  /** Renders at the next animation frame (once, however often it is called before then). */
-  readonly requestRender = (): void => this.scheduler.request();
-
-  /** Compiles the shaders of the layout as it is now, holding renders until they are ready (see `precompile`). */
-  prepare(): Promise<void> {
-    return precompile(this.renderer, this.scene, this.camera, this.scheduler);
-  }
-
-  renderNow(): void {
-    this.renderer.render(this.scene, this.camera);
+    this.loop.request();
   }
 }

@@ -1,14 +1,16 @@
 // The three.js view: the mesh (flat shaded, or textured with a checkerboard or a
 // distortion heat map through the UVs), an optional edge overlay, feature /
 // boundary / seam lines drawn thick on top, cones and boundary corners, picking
-// of edges and vertices. Renders on demand, not in a loop.
+// of edges and vertices. Renders on demand (see render-loop.ts), not continuously.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
 import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
 import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
+import { COLORS, checkerTexture, coneColor } from './palette';
 import type { Cone } from './protocol';
-import { edgeSegments, heatRgb } from './solve-view';
+import { RenderLoop, createRenderer } from './render-loop';
+import { edgeSegments } from './solve-view';
 
 export interface MeshData {
   positions: Float32Array;
@@ -17,123 +19,6 @@ export interface MeshData {
 }
 
 export type SurfaceMode = 'shaded' | 'checker' | 'distortion';
-
-export const COLORS = {
-  feature: 0xff9f1c,
-  boundary: 0x2ec4b6,
-  seam: 0xff4fa3,
-  unaligned: 0xff1f1f, // requested features the map could not align
-  problem: 0xb6ff00, // where a solve failed: vertices (markers) and edges
-  conePlus: 0xe63946, // k = +1 (angle deficit)
-  coneMinus: 0x3a86ff, // k = −1 (angle excess)
-  coneOther: 0xffd60a, // |k| > 1
-  corner: 0xf1f1f1,
-  anchor: 0xffffff,
-  hover: 0xfff275,
-};
-
-export function coneColor(k: number): number {
-  return k === 1 ? COLORS.conePlus : k === -1 ? COLORS.coneMinus : COLORS.coneOther;
-}
-
-const heatScratch = [0, 0, 0];
-
-/** Distortion colour ramp (0 = none … 1 = strong): blue → white → red (see `heatRgb`). */
-export function heat(t: number, out: THREE.Color = new THREE.Color()): THREE.Color {
-  heatRgb(t, heatScratch, 0);
-  return out.setRGB(heatScratch[0]!, heatScratch[1]!, heatScratch[2]!);
-}
-
-/** An 8 × 8 checkerboard, repeating. */
-export function checkerTexture(): THREE.Texture {
-  const size = 256;
-  const c = document.createElement('canvas');
-  c.width = c.height = size;
-  const g = c.getContext('2d')!;
-  const n = 8;
-  const s = size / n;
-  for (let i = 0; i < n; i++) {
-    for (let j = 0; j < n; j++) {
-      g.fillStyle = (i + j) % 2 ? '#f4f1ea' : '#3d4f73';
-      g.fillRect(i * s, j * s, s, s);
-    }
-  }
-  const t = new THREE.CanvasTexture(c);
-  t.wrapS = t.wrapT = THREE.RepeatWrapping;
-  t.colorSpace = THREE.SRGBColorSpace;
-  t.anisotropy = 4;
-  return t;
-}
-
-/** A WebGL renderer (antialiased, drawing buffer kept for screenshots, pixel ratio ≤ 2) whose canvas, with `data-testid` = `testid`, is appended to `container`. */
-export function createRenderer(container: HTMLElement, testid: string): THREE.WebGLRenderer {
-  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
-  renderer.domElement.dataset['testid'] = testid;
-  container.appendChild(renderer.domElement);
-  return renderer;
-}
-
-/** Longest wait for shaders to compile before rendering anyway (a lost context never reports them ready). */
-const COMPILE_WAIT_MS = 3000;
-
-/**
- * Runs `draw` at the next animation frame on request, once however often it is
- * requested before then; while held, requests wait and draw once on release.
- */
-export class RenderScheduler {
-  private requested = false;
-  private holds = 0;
-  private waiting = false;
-
-  constructor(private readonly draw: () => void) {}
-
-  /** Draws at the next animation frame (or, while held, after the release). */
-  request(): void {
-    if (this.holds > 0) {
-      this.waiting = true;
-      return;
-    }
-    if (this.requested) return;
-    this.requested = true;
-    requestAnimationFrame(() => {
-      this.requested = false;
-      if (this.holds > 0) this.waiting = true;
-      else this.draw();
-    });
-  }
-
-  /** Holds drawing until `work` settles (at most COMPILE_WAIT_MS), then requests a draw if one waited. */
-  async holdWhile(work: Promise<unknown>): Promise<void> {
-    this.holds++;
-    let timer = 0;
-    try {
-      await Promise.race([work.catch(() => undefined), new Promise((r) => (timer = window.setTimeout(r, COMPILE_WAIT_MS)))]);
-    } finally {
-      clearTimeout(timer);
-      this.holds--;
-      if (this.holds === 0 && this.waiting) {
-        this.waiting = false;
-        this.request();
-      }
-    }
-  }
-}
-
-/** Head start given to shader compilation where its end cannot be observed without blocking. */
-const COMPILE_HEAD_START_MS = 10;
-
-/**
- * Compiles the shaders `scene` needs through `renderer` while `scheduler` holds
- * drawing, so that the next frame does not stall on them; resolves when they are
- * ready (with KHR_parallel_shader_compile) or after a short head start (without
- * it, e.g. SwiftShader or Firefox, where `compileAsync` would also warn).
- */
-export function precompile(renderer: THREE.WebGLRenderer, scene: THREE.Scene, camera: THREE.Camera, scheduler: RenderScheduler): Promise<void> {
-  if (renderer.extensions.has('KHR_parallel_shader_compile')) return scheduler.holdWhile(renderer.compileAsync(scene, camera));
-  renderer.compile(scene, camera);
-  return scheduler.holdWhile(new Promise((resolve) => setTimeout(resolve, COMPILE_HEAD_START_MS)));
-}
 
 /** A solve's surface for the 3D view: positions and checker-scaled UVs per face corner, optional rgb per corner. */
 export interface UvSurface {
@@ -173,11 +58,12 @@ export class Viewer {
   private mode: SurfaceMode = 'shaded';
   private checker: THREE.Texture | null = null;
   private readonly raycaster = new THREE.Raycaster();
-  /** Called after every render (the UV view follows the hover state). */
-  onRender: (() => void) | null = null;
+  /** Draws the scene on request (see `RenderLoop`). */
+  readonly loop: RenderLoop;
 
   constructor(private readonly container: HTMLElement) {
     this.renderer = createRenderer(container, 'canvas');
+    this.loop = new RenderLoop(this.renderer, this.scene, this.camera);
 
     this.scene.background = new THREE.Color(0x2b313b);
     this.scene.add(new THREE.HemisphereLight(0xf2f5ff, 0x3a3f48, 1.6));
@@ -188,7 +74,7 @@ export class Viewer {
     this.group.add(this.markers);
 
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
-    this.controls.addEventListener('change', () => this.requestRender());
+    this.controls.addEventListener('change', () => this.loop.request());
 
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
@@ -292,7 +178,7 @@ export class Viewer {
       this.uvMesh.visible = textured;
     }
     this.mesh.visible = !textured;
-    this.requestRender();
+    this.loop.request();
   }
 
   get wireframeAvailable(): boolean {
@@ -302,7 +188,7 @@ export class Viewer {
   setWireframe(visible: boolean): void {
     this.wireVisible = visible;
     if (this.wire) this.wire.visible = visible;
-    this.requestRender();
+    this.loop.request();
   }
 
   /**
@@ -323,7 +209,7 @@ export class Viewer {
       this.lines.delete(name);
     }
     if (!this.data || seg.length === 0) {
-      if (old) this.requestRender();
+      if (old) this.loop.request();
       return;
     }
     const g = new LineSegmentsGeometry();
@@ -346,7 +232,7 @@ export class Viewer {
     lines.renderOrder = 2 + order;
     this.lines.set(name, lines);
     this.group.add(lines);
-    this.requestRender();
+    this.loop.request();
   }
 
   /** Cones as spheres coloured by index; boundary corners as small cubes. */
@@ -377,7 +263,7 @@ export class Viewer {
     };
     place(cones, new THREE.SphereGeometry(r, 20, 14), (c) => coneColor(c.k));
     place(corners, new THREE.BoxGeometry(r * 1.7, r * 1.7, r * 1.7), () => COLORS.corner);
-    this.requestRender();
+    this.loop.request();
   }
 
   /** Marks the first vertex of a Shift-click path (null removes the marker). */
@@ -396,7 +282,7 @@ export class Viewer {
       this.anchor.renderOrder = 10;
       this.group.add(this.anchor);
     }
-    this.requestRender();
+    this.loop.request();
   }
 
   /**
@@ -424,14 +310,14 @@ export class Viewer {
       this.problemMarkers = im;
       this.group.add(im);
     }
-    this.requestRender();
+    this.loop.request();
   }
 
   /** Highlights one face (hover sync with the UV view); null removes it. */
   setHoverFace(face: number | null): void {
     if (face === null || !this.data) {
       if (this.hover) this.hover.visible = false;
-      this.requestRender();
+      this.loop.request();
       return;
     }
     if (!this.hover) {
@@ -450,7 +336,7 @@ export class Viewer {
     attr.needsUpdate = true;
     this.hover.geometry.computeBoundingSphere();
     this.hover.visible = true;
-    this.requestRender();
+    this.loop.request();
   }
 
   /** Position of a mesh vertex on the page (CSS px, client coordinates); null when behind the camera. */
@@ -541,7 +427,7 @@ export class Viewer {
     this.controls.minDistance = Math.min(r, whole) * 0.05;
     this.controls.maxDistance = fitting(whole) * 5;
     this.controls.update();
-    this.requestRender();
+    this.loop.request();
   }
 
   private clear(): void {
@@ -576,23 +462,7 @@ export class Viewer {
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
     for (const m of this.lineMaterials) m.resolution.set(w, h);
-    this.requestRender();
-  }
-
-  private readonly scheduler = new RenderScheduler(() => this.renderNow());
-
-  /** Renders at the next animation frame (once, however often it is called before then). */
-  readonly requestRender = (): void => this.scheduler.request();
-
-  /** Compiles the shaders of the scene as it is now, holding renders until they are ready (see `precompile`). */
-  prepare(): Promise<void> {
-    return precompile(this.renderer, this.scene, this.camera, this.scheduler);
-  }
-
-  /** Renders now (used before screenshots and after loading, so "ready" means drawn). */
-  renderNow(): void {
-    this.renderer.render(this.scene, this.camera);
-    this.onRender?.();
+    this.loop.request();
   }
 }
 

@@ -8,6 +8,7 @@
 // worker opens the same mesh and places some of the cut mesh's components
 // (they are independent), which halves the cone stage on two cores.
 import type { ErrorLocation, ImportResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
+import type { SolveTuning } from './state';
 
 export class WorkerCrashed extends Error {
   override name = 'WorkerCrashed';
@@ -48,13 +49,6 @@ interface Helper {
 }
 
 export class MeshWorker {
-  /** Meshes with fewer faces solve in one worker: a helper's start-up (wasm, import) would cost more than it saves. */
-  static helperMinFaces = 50_000;
-  /** Test hook: the main worker waits until the helper is ready, so that both surely place components. */
-  static helperWait = false;
-  /** Test hook: refinements around cones of angle 0 before a solve fails (undefined: the library's default). */
-  static maxConeRefinements: number | undefined = undefined;
-
   private worker: Worker;
   private nextId = 1;
   private pending = new Map<number, Pending>();
@@ -182,17 +176,18 @@ export class MeshWorker {
    * Cones and UVs for the open mesh, in steps: begin, place every component
    * (some in a helper worker on large meshes), finish. Progress comes from this
    * worker (and from the helper once this one has nothing left to place).
+   * `tuning` says when a helper is used and how hard the cone placement tries.
    */
-  async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn, freeBoundary = false): Promise<SolveResult> {
+  async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn, freeBoundary: boolean, tuning: Readonly<SolveTuning>): Promise<SolveResult> {
     const generation = this.restarts;
     /** Throws `Cancelled` once this worker was replaced (cancel or crash) since the solve began. */
     const alive = (): void => {
       if (this.restarts !== generation) throw new Cancelled('cancelled');
     };
-    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq, freeBoundary, maxConeRefinements: MeshWorker.maxConeRefinements }, [], onProgress);
+    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq, freeBoundary, maxConeRefinements: tuning.maxConeRefinements }, [], onProgress);
     const queue = Array.from(schedule);
     const total = schedule.length;
-    const helper = this.startHelper(features, alphaSmooth, miq, freeBoundary, schedule);
+    const helper = this.startHelper(features, alphaSmooth, miq, freeBoundary, schedule, tuning.helperMinFaces);
     let ownDone = false;
     let helperBusy = false;
     let placed = 0;
@@ -207,7 +202,7 @@ export class MeshWorker {
       else onProgress(stage, step, remaining);
     };
     const own = async (): Promise<void> => {
-      if (helper && MeshWorker.helperWait) await helper.ready.catch(() => {});
+      if (helper && tuning.helperWait) await helper.ready.catch(() => {});
       alive();
       for (let c = queue.shift(); c !== undefined; c = queue.shift()) {
         await this.send({ type: 'solve-place', component: c, share: false }, [], placing);
@@ -257,10 +252,10 @@ export class MeshWorker {
     }
   }
 
-  /** A helper for a solve of `schedule`'s components, or null when one would not pay. */
-  private startHelper(features: Uint32Array, alphaSmooth: number, miq: boolean, freeBoundary: boolean, schedule: Uint32Array): Helper | null {
+  /** A helper for a solve of `schedule`'s components, or null when one would not pay (fewer than `minFaces` faces, one component, one core). */
+  private startHelper(features: Uint32Array, alphaSmooth: number, miq: boolean, freeBoundary: boolean, schedule: Uint32Array, minFaces: number): Helper | null {
     const cores = typeof navigator === 'undefined' ? 2 : (navigator.hardwareConcurrency ?? 2);
-    if (schedule.length < 2 || this.openFaces < MeshWorker.helperMinFaces || !this.openFiles || cores < 2) return null;
+    if (schedule.length < 2 || this.openFaces < minFaces || !this.openFiles || cores < 2) return null;
     this.dropHelper();
     const worker = new MeshWorker(false);
     const files = copyFiles(this.openFiles);

@@ -1,0 +1,52 @@
+// The colours of the 3D and UV views: line and marker colours, the cone colour
+// by index, the distortion ramp as a three.js colour, and the checker texture.
+import * as THREE from 'three';
+import { heatRgb } from './solve-view';
+
+export const COLORS = {
+  feature: 0xff9f1c,
+  boundary: 0x2ec4b6,
+  seam: 0xff4fa3,
+  unaligned: 0xff1f1f, // requested features the map could not align
+  problem: 0xb6ff00, // where a solve failed: vertices (markers) and edges
+  conePlus: 0xe63946, // k = +1 (angle deficit)
+  coneMinus: 0x3a86ff, // k = −1 (angle excess)
+  coneOther: 0xffd60a, // |k| > 1
+  corner: 0xf1f1f1,
+  anchor: 0xffffff,
+  hover: 0xfff275,
+};
+
+/** The marker colour of a cone of index `k`. */
+export function coneColor(k: number): number {
+  return k === 1 ? COLORS.conePlus : k === -1 ? COLORS.coneMinus : COLORS.coneOther;
+}
+
+const heatScratch = [0, 0, 0];
+
+/** Distortion colour ramp (0 = none … 1 = strong): blue → white → red (see `heatRgb`), written to `out`. */
+export function heat(t: number, out: THREE.Color = new THREE.Color()): THREE.Color {
+  heatRgb(t, heatScratch, 0);
+  return out.setRGB(heatScratch[0]!, heatScratch[1]!, heatScratch[2]!);
+}
+
+/** A new 8 × 8 checkerboard texture, repeating. */
+export function checkerTexture(): THREE.Texture {
+  const size = 256;
+  const c = document.createElement('canvas');
+  c.width = c.height = size;
+  const g = c.getContext('2d')!;
+  const n = 8;
+  const s = size / n;
+  for (let i = 0; i < n; i++) {
+    for (let j = 0; j < n; j++) {
+      g.fillStyle = (i + j) % 2 ? '#f4f1ea' : '#3d4f73';
+      g.fillRect(i * s, j * s, s, s);
+    }
+  }
+  const t = new THREE.CanvasTexture(c);
+  t.wrapS = t.wrapT = THREE.RepeatWrapping;
+  t.colorSpace = THREE.SRGBColorSpace;
+  t.anisotropy = 4;
+  return t;
+}

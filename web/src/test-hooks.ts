@@ -1,0 +1,97 @@
+// The page's test hooks: `window.__conemap`, figures the browser tests and
+// scripts/bench.mjs read (its `state` is the store's phase), and the shape of
+// `window.__conemapTest`, the actions they call (installed by main.ts).
+import type { Stats } from './panels';
+import type { ErrorLocation } from './protocol';
+import type { PageStore, Phase } from './state';
+
+/** Figures of a finished solve, as the tests read them. */
+export interface ResultHook {
+  cones: number;
+  plus: number;
+  minus: number;
+  /** Σk over cones and over boundary corners. */
+  sumConeK: number;
+  sumCornerK: number;
+  boundaryCorners: number;
+  /** χ of the whole mesh (from the import report). */
+  eulerCharacteristic: number;
+  rounds: number;
+  featureEdges: number;
+  /** The cone count as shown in the results panel. */
+  shownCones: string;
+  uv: boolean;
+  seams: number;
+  /** `phiᵀ(alpha L + M/A) phi` of the placement. */
+  energy: number;
+  /** Components whose cones a helper worker placed. */
+  helperComponents: number;
+}
+
+/** `window.__conemap`: each part of the page keeps its fields up to date. */
+export interface Hooks {
+  /** The page's phase (read from the store). */
+  readonly state: Phase;
+  stats: (Omit<Stats, 'report'> & Partial<NonNullable<Stats['report']>>) | null;
+  lastError: string | null;
+  version: string | null;
+  workerRestarts: number;
+  /** Increments on every finished load (success or failure). */
+  loads: number;
+  /** Milliseconds of the last load's phases on the main thread's clock. */
+  timings: { read: number; worker: number; draw: number } | null;
+  /** Marked feature edges (without the fixed boundary edges). */
+  features: number;
+  /** Figures of the last finished solve (null before one, or after a new mesh). */
+  result: ResultHook | null;
+  /** Message of the last failed solve (null after a successful one). */
+  solveError: string | null;
+  /** The `location` of the last failed solve's error (null after a success, or when it names no mesh element). */
+  solveErrorLocation: ErrorLocation | null;
+  /** What the 3D view highlights of that location (valid ids only); null once cleared (Run, new mesh, feature change). */
+  errorHighlight: ErrorLocation | null;
+  /** Increments on every finished solve (success, failure or cancel). */
+  solves: number;
+  /** Face highlighted in the 3D and UV views (hover sync), or null. */
+  hoverFace: number | null;
+}
+
+/** Test-only actions (tests/e2e). */
+export interface TestActions {
+  importWithTrap(name: string, text: string): void;
+  /** Page position of the midpoint of edge `edgeId` (client CSS px). */
+  projectEdge(edgeId: number): { x: number; y: number } | null;
+  /** An interior, unmarked edge whose midpoint is visible and picks back to itself; -1 if none. */
+  visibleEdge(): number;
+  /** Edge id a click at (x, y) would toggle; -1 when none. */
+  edgeAt(x: number, y: number): number;
+  /** Smallest mesh (faces) whose solves use a helper worker; `wait`: start placing once it is ready. */
+  setHelper(minFaces: number, wait: boolean): void;
+  /** Refinements around cones of angle 0 before a solve fails (undefined: the default; 0 shows the raw placement's error). */
+  setMaxConeRefinements(n: number | undefined): void;
+  /** Position of vertex `v` of the open mesh, its page position (client CSS px), the end vertices of edge `e`. */
+  vertexPosition(v: number): [number, number, number] | null;
+  projectVertex(v: number): { x: number; y: number } | null;
+  edgeEnds(e: number): [number, number] | null;
+}
+
+declare global {
+  interface Window {
+    __conemap: Hooks;
+    __conemapTest: TestActions;
+  }
+}
+
+/** Takes the page's store and returns fresh hooks (nothing loaded or solved yet) whose `state` reads it, set as `window.__conemap`. */
+export function installHooks(store: PageStore): Hooks {
+  const hooks: Hooks = {
+    // A getter of the literal is enumerable: `page.evaluate(() => window.__conemap)` copies it with the rest.
+    get state() {
+      return store.state.phase;
+    },
+    stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
+    features: 0, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
+  };
+  window.__conemap = hooks;
+  return hooks;
+}
