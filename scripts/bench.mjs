@@ -6,6 +6,9 @@
 //   (--big adds spot subdivided three times, 375 k faces, to native:scaling)
 //   browser:solve-big / browser:solve-single: Run in the page on 207 k faces with
 //   features, and on spot ×16 / fandisk ×16 without (issue 13's page targets)
+//   native:quads / wasm-node:quads: integer-grid quantization and quad extraction
+//   on fandisk (sharp > 60°) and spot at about 1 000, 3 000 and 10 000 quads
+//   (scripts/lib/bench-quads.mjs), with QuadriFlow's figures as static rows
 //
 // Each entry of BENCHES is { env, stage, run(ctx) } and returns rows
 // { input, faces?, ms, runs?, note? } (env/stage are filled in). Later pipeline
@@ -20,6 +23,7 @@ import { createRequire } from 'node:module';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { nativeQuadRows, quadMeshes, wasmNodeQuadRows } from './lib/bench-quads.mjs';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const args = new Set(process.argv.slice(2));
@@ -317,6 +321,24 @@ function nativeScaling() {
   const e = points.reduce((a, p) => a + (p[0] - mx) * (p[1] - my), 0) / points.reduce((a, p) => a + (p[0] - mx) ** 2, 0);
   rows.push({ stage: 'growth exponent', input: 'spot.obj family', ms: NaN, note: `time ∝ faces^${e.toFixed(2)} (least squares over ${n} sizes)` });
   return rows;
+}
+
+/**
+ * Quantization and quad extraction natively (`conemap quads --report`): fandisk
+ * with sharp edges > 60°, spot without features, about 1 000 / 3 000 / 10 000
+ * quads; ms = quantize + extract.
+ */
+function nativeQuads(ctx) {
+  const bin = releaseCli();
+  if (bin.skipped) return bin;
+  return nativeQuadRows(bin, quadMeshes(ctx.inputs[0].file, sharedMeshes));
+}
+
+/** The same in wasm under node: one `MeshSession.solve` per mesh, then `session.quads(n)` per N (wall clock). */
+function wasmNodeQuads(ctx) {
+  const pkg = path.join(root, 'build/pkg-node/conemap.js');
+  if (!fs.existsSync(pkg)) return { skipped: 'build/pkg-node missing (run npm run build)' };
+  return wasmNodeQuadRows(createRequire(import.meta.url)(pkg), quadMeshes(ctx.inputs[0].file, sharedMeshes));
 }
 
 /** The whole method in wasm under node: fandisk, sharp edges > 60° as features, α = 0.01. */
@@ -670,6 +692,8 @@ const BENCHES = [
   { env: 'native', stage: 'scaling', run: nativeScaling, enabled: !args.has('--no-native') && !quick },
   { env: 'native', stage: 'free-boundary', run: nativeFreeBoundary, enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'solve', run: wasmNodeSolve, enabled: true },
+  { env: 'native', stage: 'quads', run: nativeQuads, enabled: !args.has('--no-native') },
+  { env: 'wasm-node', stage: 'quads', run: wasmNodeQuads, enabled: true },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },
   { env: 'browser', stage: 'solve-big', run: browserSolveBig, enabled: !args.has('--no-browser') && !quick },

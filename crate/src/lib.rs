@@ -5,7 +5,9 @@
 //! Data flows one way:
 //! file bytes → [`io`] (a [`RawMesh`]) → [`mesh`] (a validated [`TriMesh`]
 //! and its geometry) → [`features`] → [`cones`] (cone placement) → [`param`]
-//! (cut, field, parametrization) → [`export`]; [`pipeline`] runs them in order.
+//! (cut, field, parametrization, quantization to an integer-grid map) →
+//! [`quads`] (quad extraction and checks) → [`export`]; [`pipeline`] runs
+//! them in order.
 
 // `!(x > 0.0)` is how this crate rejects NaN along with non-positive values;
 // index loops read like the formulas they implement.
@@ -21,6 +23,7 @@ pub mod mesh;
 pub mod pipeline;
 pub mod vec3;
 pub mod param;
+pub mod quads;
 
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;

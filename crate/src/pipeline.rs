@@ -184,6 +184,17 @@ pub struct UnalignedFeature {
 }
 
 impl Solution<'_> {
+    /// This solution owning its mesh and features (to keep it past its input).
+    pub fn into_owned(self) -> Solution<'static> {
+        Solution { mesh: Cow::Owned(self.mesh.into_owned()), features: Cow::Owned(self.features.into_owned()), ..self }
+    }
+
+    /// The quantization of this map ([`param::quantize`]): set up once, run
+    /// for any grid size without placing cones again.
+    pub fn quantizer(&self) -> Result<param::quantize::Quantizer, param::quantize::QuantizeError> {
+        param::quantize::Quantizer::new(&self.mesh, &self.placement, &self.param)
+    }
+
     /// Faces (of `mesh`) whose UV triangle is flipped or degenerate.
     pub fn flipped_faces(&self) -> Vec<u32> {
         let uv = &self.param.uv;
@@ -288,20 +299,26 @@ impl Solution<'_> {
     /// split, each input corner takes the UV of that corner in the sub-face
     /// containing it (for display; exports use the solved mesh exactly).
     pub fn input_corner_uv(&self, input: &TriMesh) -> Vec<[f64; 2]> {
+        self.input_corner_values(input, &self.param.uv)
+    }
+
+    /// Per-corner values `uv` of the solved mesh (an integer-grid map, say)
+    /// on the input's corners, as [`Self::input_corner_uv`].
+    pub fn input_corner_values(&self, input: &TriMesh, uv: &[[f64; 2]]) -> Vec<[f64; 2]> {
         let (Some(of), Some(ov)) = (&self.original_face, &self.original_vertex) else {
-            return self.param.uv.clone();
+            return uv.to_vec();
         };
-        let mut uv = vec![[0.0; 2]; 3 * input.n_faces()];
+        let mut out = vec![[0.0; 2]; 3 * input.n_faces()];
         for (r, tri) in self.mesh.faces().iter().enumerate() {
             let f = of[r] as usize;
             for (k, &v) in tri.iter().enumerate() {
                 let o = ov[v as usize];
                 if let Some(j) = input.faces()[f].iter().position(|&w| w == o) {
-                    uv[3 * f + j] = self.param.uv[3 * r + k];
+                    out[3 * f + j] = uv[3 * r + k];
                 }
             }
         }
-        uv
+        out
     }
 
     /// Seam edges as ids of the INPUT mesh (seams along inserted edges are dropped).

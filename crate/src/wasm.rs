@@ -5,7 +5,9 @@
 
 use crate::cones::{self, BoundaryMode, ComponentFigures, ComponentPlacement, Cone, ConeOptions, ConePlacement, ConeProgress, ConeTimings};
 use crate::export::{self, ExportInput, ExportOptions};
+use crate::param::quantize::{GridSize, QuantizeReport, Quantizer};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
+use crate::quads::{self, check_quads, extract_quads, CheckOptions, ExtractOptions, QuadReport};
 use crate::pipeline::{ConeStage, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
 use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
@@ -51,8 +53,17 @@ pub struct MeshSession {
     mesh: Option<TriMesh>,
     /// The solve in progress through the `solve_*` steps.
     job: Option<Job>,
+    /// The last solve's map, kept for `quads` (and its quantizer, set up on first use).
+    grid: Option<GridStage>,
     refine: RefineOptions,
     boundary: BoundaryMode,
+}
+
+/// A solved map and its quantizer: changing the quad count re-runs only
+/// quantization and extraction.
+struct GridStage {
+    solution: Solution<'static>,
+    quantizer: Option<Quantizer>,
 }
 
 /// A solve run in steps: its features, its cone stage and the components placed so far.
@@ -79,7 +90,7 @@ impl MeshSession {
                 (w.positions, w.triangles)
             }
         };
-        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None, refine: RefineOptions::default(), boundary: BoundaryMode::Aligned })
+        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None, grid: None, refine: RefineOptions::default(), boundary: BoundaryMode::Aligned })
     }
 
     /// Refinements around cones of angle <= 0 that solves try before they
@@ -205,6 +216,7 @@ impl MeshSession {
     /// the components in the order to place them (largest first).
     pub fn solve_begin(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool) -> Result<Vec<u32>, JsError> {
         self.job = None;
+        self.grid = None;
         let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
         let stage = ConeStage::new(mesh, &features, &SolveOptions { cones, param: ParamOptions::default(), refine: self.refine });
         let schedule = stage.problem().schedule().iter().map(|&c| c as u32).collect();
@@ -255,7 +267,57 @@ impl MeshSession {
             notify(progress, stage, a, b);
         };
         let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
-        Ok(self.solution_object(mesh, &features, &sol)?)
+        let result = self.solution_object(mesh, &features, &sol)?;
+        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None });
+        Ok(result)
+    }
+
+    /// The integer-grid map of the last solve for about `quads` grid cells
+    /// and the quad mesh traced on it (a [`QuadsResult`]); re-runs only
+    /// quantization and extraction. Throws when nothing was solved yet, or
+    /// with the quantization error (a free boundary, say).
+    pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
+        let grid = self.grid.as_mut().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
+        if grid.quantizer.is_none() {
+            grid.quantizer = Some(grid.solution.quantizer().map_err(|e| JsError::new(&e.to_string()))?);
+        }
+        let input = self.valid_mesh()?;
+        let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
+        let sol = &grid.solution;
+        let quantizer = grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?;
+        let map = quantizer
+            .quantize(&sol.mesh, GridSize::Quads(quads as usize), &mut |done, total| notify(progress, "quantization", done, total))
+            .map_err(|e| JsError::new(&e.to_string()))?;
+        notify(progress, "quad extraction", 0, 0);
+        let quad_mesh = extract_quads(&sol.mesh, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
+        let sharp: Vec<u32> = sol.features.edges().collect();
+        let report = check_quads(&sol.mesh, &quad_mesh, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
+        let uv: Vec<f32> = sol.input_corner_values(input, &map.uv).iter().flat_map(|p| p.map(|c| c as f32)).collect();
+        let positions: Vec<f32> = quad_mesh.positions.iter().flat_map(|p| p.map(|c| c as f32)).collect();
+        let corners: Vec<u32> = quad_mesh.quads.iter().flatten().copied().collect();
+        let edges: Vec<u32> = quads::check::quad_edges(&quad_mesh).iter().flat_map(|e| e.vertices).collect();
+        let singular: Vec<u32> = report.singular_vertices.iter().filter(|v| !v.boundary).flat_map(|v| [v.vertex, v.valence]).collect();
+        let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
+        let mut grid_input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &map.uv)
+            .map_err(|e| JsError::new(&e.to_string()))?;
+        if let (Some(source), 0) = (&self.source, sol.splits) {
+            grid_input = grid_input.with_gltf_source(source, &self.files[0], &self.files[1..]);
+        }
+        let grid_glb = export::write_glb(&grid_input, &ExportOptions { grid_units: true, checker_cell: Some(1.0), ..ExportOptions::default() });
+        let obj = export::quads::write_quad_obj(&quad_mesh, &format!("{} quads, grid cell {}", quad_mesh.n_quads(), map.report.grid_size));
+        Ok(to_js(&QuadsResult {
+            quantization: &map.report,
+            report: &report,
+            uv: Float32Array::from(&uv[..]),
+            positions: Float32Array::from(&positions[..]),
+            quads: Uint32Array::from(&corners[..]),
+            edges: Uint32Array::from(&edges[..]),
+            singular: Uint32Array::from(&singular[..]),
+            defects: quad_mesh.defects.len(),
+            obj: Uint8Array::from(obj.as_bytes()),
+            glb: Uint8Array::from(&export::quads::write_quad_glb(&quad_mesh)[..]),
+            grid_glb: Uint8Array::from(&grid_glb[..]),
+        })?)
     }
 }
 
@@ -430,6 +492,37 @@ struct SolveResult<'a> {
     /// The OBJ export, UTF-8.
     #[serde(with = "serde_wasm_bindgen::preserve")]
     obj: Uint8Array,
+}
+
+/// What `quads` returns; mirrored field for field by `QuadsResult` in
+/// `web/src/protocol.ts`.
+#[derive(Serialize)]
+struct QuadsResult<'a> {
+    quantization: &'a QuantizeReport,
+    report: &'a QuadReport,
+    /// The integer-grid map, two per input face corner, in grid units.
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    uv: Float32Array,
+    /// Quad mesh: three per vertex, four vertex ids per quad, two per edge,
+    /// and (vertex, valence) per interior singular vertex.
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    positions: Float32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    quads: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    edges: Uint32Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    singular: Uint32Array,
+    /// Places the extractor had to repair.
+    defects: usize,
+    /// The quad mesh as OBJ (UTF-8) and binary glTF.
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    obj: Uint8Array,
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    glb: Uint8Array,
+    /// The solved mesh with the integer-grid UVs (grid units), binary glTF.
+    #[serde(with = "serde_wasm_bindgen::preserve")]
+    grid_glb: Uint8Array,
 }
 
 /// The map's [`Metrics`] and the distortion of every input face.

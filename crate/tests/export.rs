@@ -234,7 +234,7 @@ fn gltf_with_data_uri_and_checker() {
     let mesh = TriMesh::from_raw(&raw).unwrap();
     let uv = cube_uv(&raw);
     let input = ExportInput::new(&raw, &mesh, &uv).unwrap();
-    let options = ExportOptions { checker: true, checker_cell: Some(1.0), name: Some("cube".into()) };
+    let options = ExportOptions { checker: true, checker_cell: Some(1.0), name: Some("cube".into()), ..ExportOptions::default() };
     let text = export::write_gltf(&input, &options);
     assert!(text.contains("data:application/octet-stream;base64,"));
     let back = import(&InputFile { name: "cube.gltf".into(), bytes: text.clone().into_bytes() }, &[]).unwrap();

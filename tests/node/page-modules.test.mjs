@@ -1,5 +1,6 @@
 // Unit tests of the page's pure modules (web/src/topology.ts, features.ts,
-// solve-view.ts, state.ts, dom.ts): each is bundled by esbuild to an ES module and imported, so
+// solve-view.ts, state.ts, dom.ts) and the pure functions of quad-panel.ts and
+// quad-view.ts: each is bundled by esbuild to an ES module and imported, so
 // the tests run the page's code itself, without a browser.
 import { before, describe, it } from 'node:test';
 import assert from 'node:assert/strict';
@@ -285,6 +286,60 @@ describe('state.ts', () => {
     assert.deepEqual(dataset, { state: 'solving', solving: 'true' });
     store.transition('solved');
     assert.deepEqual(dataset, { state: 'solved' }, 'solving is removed, not left false');
+  });
+
+  it('keeps the quads phase only while solved: off on leaving, rejected elsewhere, mirrored unless off', () => {
+    const { store, seen } = driven('ready');
+    assert.equal(store.state.quads, 'off');
+    for (const q of ['running', 'shown', 'failed']) assert.throws(() => store.setQuads(q), st.InvalidTransition, `${q} while ready`);
+    store.setQuads('off'); // always allowed; no change, no notification
+    const notified = seen.length;
+    store.setQuads('off');
+    assert.equal(seen.length, notified);
+    const dataset = {};
+    st.mirrorToDataset(store, dataset);
+    store.transition('solving');
+    store.transition('solved');
+    store.setQuads('running');
+    assert.deepEqual(dataset, { state: 'solved', quads: 'running' });
+    store.setQuads('shown');
+    assert.equal(store.state.quads, 'shown');
+    store.transition('solving');
+    assert.equal(store.state.quads, 'off', 'a solve drops the quads');
+    assert.deepEqual(dataset, { state: 'solving', solving: 'true' });
+    assert.throws(() => store.setQuads('running'), st.InvalidTransition);
+    store.transition('solved');
+    store.setQuads('failed');
+    store.beginLoad();
+    assert.equal(store.state.quads, 'off', 'a load drops the quads');
+    assert.deepEqual(dataset, { state: 'loading' });
+  });
+});
+
+describe('quad-panel.ts and quad-view.ts', () => {
+  let panel;
+  let view;
+  before(async () => {
+    panel = await load('quad-panel');
+    view = await load('quad-view');
+  });
+
+  it('maps the log slider to counts of two significant digits over 100 .. 30 000', () => {
+    const { min, max, initial } = panel.QUAD_SLIDER;
+    assert.equal(panel.quadsOf(min), 100);
+    assert.equal(panel.quadsOf(max), 30_000);
+    assert.equal(panel.quadsOf(initial), 3_000);
+    assert.equal(panel.quadsOf(Math.log10(2000)), 2000);
+    assert.equal(panel.quadsOf(Math.log10(1234)), 1200);
+    assert.equal(panel.quadsOf(Math.log10(187)), 190);
+  });
+
+  it('draws quad edges as segments and counts singular vertices by valence', () => {
+    const positions = Float32Array.from([0, 0, 0, 1, 0, 0, 1, 1, 0]);
+    const seg = view.quadEdgeSegments(positions, Uint32Array.from([0, 1, 1, 2]));
+    assert.deepEqual([...seg], [0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 1, 0]);
+    assert.deepEqual(view.valenceCounts(Uint32Array.from([7, 3, 8, 5, 9, 3, 10, 6])), { three: 2, five: 1, other: 1 });
+    assert.deepEqual(view.valenceCounts(new Uint32Array(0)), { three: 0, five: 0, other: 0 });
   });
 });
 

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import { before, test } from 'node:test';
-import { loadPageModule, loadWasm, sharedMesh } from './wasm.mjs';
+import { committedFandisk, loadPageModule, loadWasm, sharedMesh } from './wasm.mjs';
 
 const wasm = loadWasm();
 let protocol;
@@ -41,4 +41,44 @@ test('solve returns exactly the fields of WasmSolveResult, arrays typed and size
   assert.equal(r.metrics.flipped, 0);
   assert.equal(r.feature_alignment.requested, 0);
   assert.ok(r.param_timings.arap >= 0 && r.timings.total > 0);
+});
+
+test('quads returns exactly the fields of QuadsResult: a valid quad mesh, grid UVs, a quad-only OBJ', () => {
+  const session = open(committedFandisk);
+  assert.throws(() => session.quads(1000, () => {}), /solve/, 'quads need a solve first');
+  const faces = session.indices().length / 3;
+  session.solve(session.sharp_edges(60), 1, false, () => {});
+  const stages = new Set();
+  const r = session.quads(1000, (stage) => stages.add(stage));
+  assert.deepEqual([...stages], ['quantization', 'quad extraction']);
+  assert.deepEqual(sorted(r), sorted(protocol.QUADS_RESULT_KEYS));
+  assert.deepEqual(sorted(r.quantization), sorted(protocol.QUANTIZE_REPORT_KEYS));
+  assert.deepEqual(sorted(r.report), sorted(protocol.QUAD_REPORT_KEYS));
+  assert.equal(Object.getPrototypeOf(r.report.valence_histogram.interior), Object.prototype, 'a plain object, not a Map');
+  for (const key of ['uv', 'positions']) assert.ok(r[key] instanceof Float32Array, key);
+  for (const key of ['quads', 'edges', 'singular']) assert.ok(r[key] instanceof Uint32Array, key);
+  for (const key of ['obj', 'glb', 'grid_glb']) assert.ok(r[key] instanceof Uint8Array, key);
+  assert.equal(r.uv.length, 6 * faces, 'uv: 2 per input face corner');
+  assert.ok(r.uv.every(Number.isFinite));
+  const n = r.quads.length / 4;
+  assert.equal(r.report.quads, n);
+  assert.ok(Math.abs(n - 1000) < 150, `${n} quads for 1000`);
+  const vertices = r.positions.length / 3;
+  assert.equal(r.report.vertices, vertices);
+  for (let q = 0; q < n; q++) {
+    const ids = Array.from(r.quads.subarray(4 * q, 4 * q + 4));
+    assert.ok(ids.every((v) => v < vertices), `quad ${q} has a vertex out of range`);
+    assert.equal(new Set(ids).size, 4, `quad ${q} repeats a vertex`);
+  }
+  assert.equal(r.edges.length / 2, r.report.edges);
+  assert.ok(r.edges.every((v) => v < vertices));
+  assert.equal(r.singular.length % 2, 0);
+  assert.equal(r.singular.length / 2, r.report.singular_vertices.filter((v) => !v.boundary).length);
+  assert.equal(r.defects, r.report.defects);
+  assert.ok(r.quantization.grid_size > 0 && r.quantization.cells > 0);
+  const obj = new TextDecoder().decode(r.obj);
+  const faceLines = obj.split('\n').filter((l) => l.startsWith('f '));
+  assert.equal(faceLines.length, n, 'one f line per quad');
+  for (const l of faceLines) assert.equal(l.trim().split(/\s+/).length, 5, `not a quad: ${l}`);
+  for (const glb of [r.glb, r.grid_glb]) assert.equal(new TextDecoder().decode(glb.subarray(0, 4)), 'glTF');
 });

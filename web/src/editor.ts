@@ -1,7 +1,9 @@
 // The solve side of the page put together: the feature editor, the solve
-// controller and the result panel, told of a new mesh and of each other's news.
+// controller, the result panel and its quads, told of a new mesh and of each
+// other's news.
 import { FeatureEditor } from './feature-editor';
 import type { ImportResult } from './protocol';
+import { QuadPanel } from './quad-panel';
 import { ResultPanel } from './result-panel';
 import { SolveController } from './solve-controller';
 import type { PageStore } from './state';
@@ -12,15 +14,17 @@ import type { MeshWorker } from './worker-client';
 export class Editor {
   readonly features: FeatureEditor;
   readonly results: ResultPanel;
+  readonly quads: QuadPanel;
   readonly solve: SolveController;
 
-  /** Wires the three parts to `viewer`, `worker`, the page's `store` and the test `hooks` they keep up to date. */
+  /** Wires the four parts to `viewer`, `worker`, the page's `store` and the test `hooks` they keep up to date. */
   constructor(viewer: Viewer, worker: MeshWorker, store: PageStore, hooks: Hooks) {
     this.features = new FeatureEditor(viewer, worker, hooks, {
       onChange: () => this.solve.featuresChanged(),
       onError: (message) => this.solve.showError(message),
     });
-    this.results = new ResultPanel(viewer, hooks);
+    this.quads = new QuadPanel(viewer, worker, store, hooks, (message) => this.solve.showError(message), () => this.solve.hideError());
+    this.results = new ResultPanel(viewer, hooks, this.quads);
     this.solve = new SolveController(viewer, worker, store, this.features, this.results, hooks);
   }
 

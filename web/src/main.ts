@@ -169,6 +169,7 @@ window.__conemapTest = {
   vertexPosition: (v) => editor.features.vertexPosition(v),
   projectVertex: (v) => editor.features.projectVertex(v),
   edgeEnds: (e) => editor.features.edgeEnds(e),
+  setQuadCount: (n) => editor.quads.setCount(n),
 };
 
 void listSamples();

@@ -15,7 +15,16 @@ export const COLORS = {
   corner: 0xf1f1f1,
   anchor: 0xffffff,
   hover: 0xfff275,
+  quadEdge: 0x2ad17a, // quad mesh edges (over the grid checker: apart from both of its colours)
 };
+
+/** The marker colour of a singular vertex of the quad mesh by valence: 3 and 5 as the cones of index +1 and −1 that make them. */
+export function valenceColor(valence: number): number {
+  return valence === 3 ? COLORS.conePlus : valence === 5 ? COLORS.coneMinus : COLORS.coneOther;
+}
+
+/** Squares along each side of the checker texture: a UV span of 1 / CHECKER_SQUARES is one square. */
+export const CHECKER_SQUARES = 8;
 
 /** The marker colour of a cone of index `k`. */
 export function coneColor(k: number): number {
@@ -30,13 +39,13 @@ export function heat(t: number, out: THREE.Color = new THREE.Color()): THREE.Col
   return out.setRGB(heatScratch[0]!, heatScratch[1]!, heatScratch[2]!);
 }
 
-/** A new 8 × 8 checkerboard texture, repeating. */
+/** A new CHECKER_SQUARES × CHECKER_SQUARES checkerboard texture, repeating. */
 export function checkerTexture(): THREE.Texture {
   const size = 256;
   const c = document.createElement('canvas');
   c.width = c.height = size;
   const g = c.getContext('2d')!;
-  const n = 8;
+  const n = CHECKER_SQUARES;
   const s = size / n;
   for (let i = 0; i < n; i++) {
     for (let j = 0; j < n; j++) {

@@ -1,7 +1,7 @@
 // Messages between the page and the wasm worker. Every request carries an id;
 // the worker answers with any number of `progress` messages, then exactly one
 // `result` or `error` with the same id. The worker keeps one `MeshSession`
-// (the last mesh opened); later requests (`sharp`, `solve-*`) refer to it.
+// (the last mesh opened); later requests (`sharp`, `solve-*`, `quads`) refer to it.
 
 /** One input file: the mesh first, companion files (.bin, textures) after it. */
 export interface WireFile {
@@ -27,7 +27,9 @@ export type Request =
   | { id: number; type: 'solve-place'; component: number; share: boolean }
   | { id: number; type: 'solve-add'; bytes: Uint8Array }
   /** Answers a `SolveResult`. */
-  | { id: number; type: 'solve-finish' };
+  | { id: number; type: 'solve-finish' }
+  /** The integer-grid map and quad mesh of the session's last solve for about `quads` grid cells; answers a `QuadsResult`. */
+  | { id: number; type: 'quads'; quads: number };
 
 /** Answer to `solve-begin`: the components in the order to place them. */
 export interface SolveBegun {
@@ -205,6 +207,106 @@ export const WASM_SOLVE_RESULT_KEYS = {
   ...CONE_RESULT_KEYS, uv: true, seam_edges: true, metrics: true, param_timings: true, refinement: true,
   flip_refinements: true, realized_cones: true, feature_alignment: true, glb: true, obj: true,
 } as const satisfies Keys<WasmSolveResult>;
+
+/** Figures of one quantization (crate `param::quantize::QuantizeReport`). */
+export interface QuantizeReport {
+  /** Grid cell edge length, model units. */
+  grid_size: number;
+  point_forms: number;
+  translation_forms: number;
+  batches: number;
+  /** Integers moved by one to undo a collapse. */
+  moved_integers: number;
+  arap_iterations: number;
+  /** The rounded map had flipped triangles and the untangler removed them all. */
+  untangled: boolean;
+  /** Forms left at a non-integer value (0 on success). */
+  conflicts: number;
+  integer_residual: number;
+  /** Distortion (eq. 19) of the seamless map and of the integer-grid map. */
+  distortion_before: number;
+  distortion_after: number;
+  /** Flipped or degenerate triangles of the integer-grid map. */
+  flipped: number;
+  /** Vertices around which the map winds (UV angle sum off the seamless map's by 2π). */
+  wound_vertices: number;
+  /** Total UV area in grid cells (about the number of quads). */
+  cells: number;
+  seconds: number;
+}
+
+/** A vertex of valence other than 4 inside (3 on the boundary). */
+export interface SingularVertex {
+  vertex: number;
+  valence: number;
+  boundary: boolean;
+}
+
+/** Figures of a quad mesh (crate `quads::check::QuadReport`); angles in degrees; distances absent when not computed. */
+export interface QuadReport {
+  quads: number;
+  vertices: number;
+  edges: number;
+  euler_characteristic: number;
+  boundary_loops: number;
+  components: number;
+  non_manifold_edges: number;
+  non_manifold_vertices: number;
+  degenerate_quads: number;
+  unreferenced_vertices: number;
+  singular_vertices: SingularVertex[];
+  /** Vertex counts by valence (keys are valences). */
+  valence_histogram: { interior: Record<string, number>; boundary: Record<string, number> };
+  angle_mean_deviation: number;
+  angle_max_deviation: number;
+  fraction_corners_45_135: number;
+  flipped_quads: number;
+  distance_quads_to_input: number | undefined;
+  distance_quads_to_input_relative: number | undefined;
+  distance_input_to_quads: number | undefined;
+  distance_input_to_quads_relative: number | undefined;
+  sharp_edges_checked: number;
+  fraction_sharp_within_tolerance: number | undefined;
+  defects: number;
+}
+
+/** What the wasm `quads` returns (crate `wasm::QuadsResult`, field for field). */
+export interface QuadsResult {
+  quantization: QuantizeReport;
+  report: QuadReport;
+  /** The integer-grid map in grid units (one cell = 1), two per input face corner 3f+k. */
+  uv: Float32Array;
+  /** The quad mesh: xyz per vertex, 4 vertex ids per quad (CCW), 2 per edge. */
+  positions: Float32Array;
+  quads: Uint32Array;
+  edges: Uint32Array;
+  /** (vertex id, valence) per interior singular vertex. */
+  singular: Uint32Array;
+  /** Places the extractor repaired (0 on a valid map). */
+  defects: number;
+  /** The quad mesh as OBJ (UTF-8) and as binary glTF; the input mesh with the grid UVs as binary glTF. */
+  obj: Uint8Array;
+  glb: Uint8Array;
+  grid_glb: Uint8Array;
+}
+
+export const QUANTIZE_REPORT_KEYS = {
+  grid_size: true, point_forms: true, translation_forms: true, batches: true, moved_integers: true, arap_iterations: true,
+  untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
+  wound_vertices: true, cells: true, seconds: true,
+} as const satisfies Keys<QuantizeReport>;
+export const QUAD_REPORT_KEYS = {
+  quads: true, vertices: true, edges: true, euler_characteristic: true, boundary_loops: true, components: true,
+  non_manifold_edges: true, non_manifold_vertices: true, degenerate_quads: true, unreferenced_vertices: true,
+  singular_vertices: true, valence_histogram: true, angle_mean_deviation: true, angle_max_deviation: true,
+  fraction_corners_45_135: true, flipped_quads: true, distance_quads_to_input: true, distance_quads_to_input_relative: true,
+  distance_input_to_quads: true, distance_input_to_quads_relative: true, sharp_edges_checked: true,
+  fraction_sharp_within_tolerance: true, defects: true,
+} as const satisfies Keys<QuadReport>;
+export const QUADS_RESULT_KEYS = {
+  quantization: true, report: true, uv: true, positions: true, quads: true, edges: true, singular: true, defects: true,
+  obj: true, glb: true, grid_glb: true,
+} as const satisfies Keys<QuadsResult>;
 
 /** A solve as the page receives it: the wasm result and what the worker adds. */
 export interface SolveResult extends WasmSolveResult {

@@ -1,12 +1,14 @@
 // A finished solve on screen: the figures table, the cones, seams and checker
 // (or distortion) surface in the 3D view, the UV layout beside it with hover in
 // sync, the surface-mode switch with the distortion legend, and the downloads
-// (glTF, OBJ, the JSON report).
+// (glTF, OBJ, the JSON report); the quads of the map are quad-panel.ts.
 import * as THREE from 'three';
 import { $, definitionList, fmt, fmtInt, fmtMs } from './dom';
+import { download, downloadBytes, fileStem } from './downloads';
 import type { OpenMesh } from './feature-editor';
 import { COLORS, heat } from './palette';
 import type { SolveResult, SolveView } from './protocol';
+import type { QuadPanel } from './quad-panel';
 import { afterNextFrame, latestPerFrame } from './render-loop';
 import { buildSolveView } from './solve-view';
 import type { Hooks, ResultHook } from './test-hooks';
@@ -38,9 +40,11 @@ export class ResultPanel {
     uvFrame: $<HTMLButtonElement>('uv-frame'),
   };
 
+  /** `quads` is told of every map shown and cleared. */
   constructor(
     private readonly viewer: Viewer,
     private readonly hooks: Pick<Hooks, 'result' | 'hoverFace'>,
+    private readonly quads: QuadPanel,
   ) {
     this.uvView = new UvView(this.el.uv);
     this.uvView.onHover = (face) => this.hoverSync(face);
@@ -64,6 +68,7 @@ export class ResultPanel {
     this.viewer.setCones([], []);
     this.viewer.setLines('seams', new Uint32Array(0), [], COLORS.seam);
     this.viewer.setLines('unaligned', new Uint32Array(0), [], COLORS.unaligned);
+    this.quads.setMap(null);
     this.viewer.setUvSurface(null);
     this.viewer.setHoverFace(null);
   }
@@ -127,6 +132,7 @@ export class ResultPanel {
       this.viewer.setSurfaceMode('shaded');
     }
     this.hooks.result = figures;
+    if (hasUv) this.quads.setMap(m);
     return true;
   }
 
@@ -183,11 +189,11 @@ export class ResultPanel {
     });
     this.el.glb.addEventListener('click', () => {
       const glb = this.shown?.result.glb;
-      if (glb) download(new Blob([glb as Uint8Array<ArrayBuffer>], { type: 'model/gltf-binary' }), `${this.baseName()}-uv.glb`);
+      if (glb) downloadBytes(glb, 'model/gltf-binary', `${this.baseName()}-uv.glb`);
     });
     this.el.obj.addEventListener('click', () => {
       const obj = this.shown?.result.obj;
-      if (obj) download(new Blob([obj as Uint8Array<ArrayBuffer>], { type: 'text/plain' }), `${this.baseName()}-uv.obj`);
+      if (obj) downloadBytes(obj, 'text/plain', `${this.baseName()}-uv.obj`);
     });
   }
 
@@ -225,9 +231,9 @@ export class ResultPanel {
     }
   }
 
-  /** The file name stem of the downloads: the mesh's label without "(+N more)" and extension. */
+  /** The file name stem of the downloads (see `fileStem`). */
   private baseName(): string {
-    return (this.shown?.mesh.label ?? 'mesh').replace(/ \(\+\d+ more\)$/, '').replace(/\.[^.]+$/, '');
+    return fileStem(this.shown?.mesh.label);
   }
 }
 
@@ -311,16 +317,4 @@ function buildView(m: OpenMesh, r: SolveResult): SolveView {
     faceEdges: m.data.faceEdges, uv: r.uv, seamEdges: r.seam_edges ?? null,
     perFaceDistortion: r.metrics?.per_face_distortion ?? null,
   });
-}
-
-/** Saves `blob` as a download named `name`. */
-function download(blob: Blob, name: string): void {
-  const url = URL.createObjectURL(blob);
-  const a = document.createElement('a');
-  a.href = url;
-  a.download = name;
-  document.body.append(a);
-  a.click();
-  a.remove();
-  setTimeout(() => URL.revokeObjectURL(url), 10_000);
 }

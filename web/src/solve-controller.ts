@@ -202,6 +202,12 @@ export class SolveController {
     this.el.error.append(line);
   }
 
+  /** Hides the error box and its highlight. */
+  hideError(): void {
+    this.clearProblem();
+    this.el.error.hidden = true;
+  }
+
   /** Draws `loc` (its ids that exist on this mesh) in the 3D view; returns what is drawn, or null when nothing is. */
   private showProblem(loc: ErrorLocation): ErrorLocation | null {
     const m = this.features.mesh;

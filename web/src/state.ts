@@ -1,10 +1,18 @@
 // The page's state, in one store: the phase the page is in, the token of the
 // newest load (results of older loads are stale), whether a finished solve is
-// being put on screen, and the solve tuning the test hooks set. Phases change
-// only through `transition`, which rejects the changes that make no sense and
-// tells the subscribers of every change. Pure: no DOM, no worker.
+// being put on screen, where the quads of the solved map stand, and the solve
+// tuning the test hooks set. Phases change only through `transition`, which
+// rejects the changes that make no sense and tells the subscribers of every
+// change. Pure: no DOM, no worker.
 
 export type Phase = 'idle' | 'loading' | 'ready' | 'solving' | 'solved' | 'error';
+
+/**
+ * The quads of the solved map: none asked for (or quad mode off), being
+ * computed, shown, or the last request failed (the map stays shown). Anything
+ * but 'off' only in phase `solved`.
+ */
+export type QuadsPhase = 'off' | 'running' | 'shown' | 'failed';
 
 /** How a solve is spread over workers and how hard it tries (the tests change these through `window.__conemapTest`). */
 export interface SolveTuning {
@@ -22,6 +30,8 @@ export interface PageState {
   readonly load: number;
   /** Only while solving: the solver has answered and its result is being put on screen. */
   readonly building: boolean;
+  /** Where the quads of the solved map stand; 'off' outside `solved`. */
+  readonly quads: QuadsPhase;
   readonly tuning: Readonly<SolveTuning>;
 }
 
@@ -50,6 +60,7 @@ export class PageStore {
     phase: 'idle',
     load: 0,
     building: false,
+    quads: 'off',
     tuning: { helperMinFaces: 50_000, helperWait: false, maxConeRefinements: undefined },
   };
   private readonly listeners = new Set<Listener>();
@@ -62,17 +73,28 @@ export class PageStore {
   /**
    * Goes to phase `to` (with `building`: solving and putting the result on
    * screen); throws `InvalidTransition` when `to` cannot follow the current
-   * phase, or `building` is asked for outside `solving`. Notifies the subscribers.
+   * phase, or `building` is asked for outside `solving`. Leaving `solved`
+   * turns the quads 'off'. Notifies the subscribers.
    */
   transition(to: Phase, { building = false }: { building?: boolean } = {}): void {
     this.check(to, building);
-    this.set({ phase: to, building });
+    this.set({ phase: to, building, ...(to === 'solved' ? {} : { quads: 'off' as const }) });
   }
 
-  /** Starts a load: goes to `loading` (see `transition`) and returns its token, which makes every earlier token stale. */
+  /**
+   * Sets where the quads stand (see `QuadsPhase`); throws `InvalidTransition`
+   * for anything but 'off' outside phase `solved`. Notifies the subscribers
+   * when it changes.
+   */
+  setQuads(quads: QuadsPhase): void {
+    if (quads !== 'off' && this.current.phase !== 'solved') throw new InvalidTransition(`quads need a solved map, not ${this.current.phase}`);
+    if (quads !== this.current.quads) this.set({ quads });
+  }
+
+  /** Starts a load: goes to `loading` (see `transition`: the quads go 'off') and returns its token, which makes every earlier token stale. */
   beginLoad(): number {
     this.check('loading', false);
-    this.set({ phase: 'loading', building: false, load: this.current.load + 1 });
+    this.set({ phase: 'loading', building: false, quads: 'off', load: this.current.load + 1 });
     return this.current.load;
   }
 
@@ -106,11 +128,17 @@ export class PageStore {
   }
 }
 
-/** Mirrors `store` into the data attributes of `dataset` (the page's body): `state` = the phase, `solving` = 'true' while solving. */
+/**
+ * Mirrors `store` into the data attributes of `dataset` (the page's body):
+ * `state` = the phase, `solving` = 'true' while solving, `quads` = the quads
+ * phase unless 'off'.
+ */
 export function mirrorToDataset(store: PageStore, dataset: DOMStringMap): () => void {
-  return store.subscribe(({ phase }) => {
+  return store.subscribe(({ phase, quads }) => {
     dataset['state'] = phase;
     if (phase === 'solving') dataset['solving'] = 'true';
     else delete dataset['solving'];
+    if (quads !== 'off') dataset['quads'] = quads;
+    else delete dataset['quads'];
   });
 }

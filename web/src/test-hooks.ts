@@ -28,6 +28,28 @@ export interface ResultHook {
   helperComponents: number;
 }
 
+/** Figures of the quads shown, as the tests read them. */
+export interface QuadsHook {
+  /** The count asked for (the slider's) and the one the extractor made. */
+  target: number;
+  quads: number;
+  /** Length of the `quads` array (4 per quad). */
+  quadIndices: number;
+  vertices: number;
+  /** Quad edge length (grid cell), model units. */
+  gridSize: number;
+  /** Interior singular vertices by valence. */
+  singular: { three: number; five: number; other: number };
+  angleMeanDeviation: number;
+  distortionBefore: number;
+  distortionAfter: number;
+  defects: number;
+  /** Face corners the grid UVs cover (2 numbers each). */
+  uvCorners: number;
+  /** The 3D checker is drawn from the grid UVs. */
+  gridChecker: boolean;
+}
+
 /** `window.__conemap`: each part of the page keeps its fields up to date. */
 export interface Hooks {
   /** The page's phase (read from the store). */
@@ -54,6 +76,12 @@ export interface Hooks {
   solves: number;
   /** Face highlighted in the 3D and UV views (hover sync), or null. */
   hoverFace: number | null;
+  /** Figures of the quads shown (null when none are). */
+  quads: QuadsHook | null;
+  /** Message of the last failed quads request (null after a success). */
+  quadsError: string | null;
+  /** Increments whenever the answer to a quads request (quads or error) is put on the page; superseded ones do not count. */
+  quadRuns: number;
 }
 
 /** Test-only actions (tests/e2e). */
@@ -73,6 +101,8 @@ export interface TestActions {
   vertexPosition(v: number): [number, number, number] | null;
   projectVertex(v: number): { x: number; y: number } | null;
   edgeEnds(e: number): [number, number] | null;
+  /** Sets the quad-count slider to about `n` quads and asks for them at once (quad mode must be on). */
+  setQuadCount(n: number): void;
 }
 
 declare global {
@@ -91,6 +121,7 @@ export function installHooks(store: PageStore): Hooks {
     },
     stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
     features: 0, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
+    quads: null, quadsError: null, quadRuns: 0,
   };
   window.__conemap = hooks;
   return hooks;

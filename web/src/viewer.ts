@@ -1,13 +1,14 @@
 // The three.js view: the mesh (flat shaded, or textured with a checkerboard or a
 // distortion heat map through the UVs), an optional edge overlay, feature /
-// boundary / seam lines drawn thick on top, cones and boundary corners, picking
-// of edges and vertices. Renders on demand (see render-loop.ts), not continuously.
+// boundary / seam lines drawn thick on top, cones and boundary corners, named
+// overlays (the quad mesh, see quad-view.ts), picking of edges and vertices.
+// Renders on demand (see render-loop.ts), not continuously.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
 import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
 import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
-import { COLORS, checkerTexture, coneColor } from './palette';
+import { CHECKER_SQUARES, COLORS, checkerTexture, coneColor } from './palette';
 import type { Cone } from './protocol';
 import { RenderLoop, createRenderer } from './render-loop';
 import { edgeSegments } from './solve-view';
@@ -55,6 +56,10 @@ export class Viewer {
   private problemMarkers: THREE.InstancedMesh | null = null;
   private hover: THREE.Mesh | null = null;
   private uvMesh: THREE.Mesh | null = null;
+  /** The checker UVs of the UV surface, kept while the integer-grid UVs replace them (`setGridUv`). */
+  private surfaceUv: Float32Array | null = null;
+  private gridUvShown = false;
+  private readonly overlays = new Map<string, THREE.Object3D>();
   private mode: SurfaceMode = 'shaded';
   private checker: THREE.Texture | null = null;
   private readonly raycaster = new THREE.Raycaster();
@@ -152,7 +157,10 @@ export class Viewer {
       this.uvMesh = null;
     }
     if (this.mesh) this.mesh.visible = true;
+    this.surfaceUv = null;
+    this.gridUvShown = false;
     if (surface && this.data && this.mesh) {
+      this.surfaceUv = surface.uv;
       const g = new THREE.BufferGeometry();
       g.setAttribute('position', new THREE.BufferAttribute(surface.positions, 3));
       g.setAttribute('uv', new THREE.BufferAttribute(surface.uv, 2));
@@ -162,6 +170,58 @@ export class Viewer {
       this.group.add(this.uvMesh);
     }
     this.applyMode();
+  }
+
+  /**
+   * Checker mode draws `uv` (grid units, 2 per face corner of the UV surface)
+   * one square per unit instead of the surface's own checker UVs; null goes
+   * back to those. Ignored without a UV surface or when the lengths differ.
+   * A new UV surface starts with its own UVs.
+   */
+  setGridUv(uv: Float32Array | null): void {
+    if (!this.uvMesh || !this.surfaceUv || (uv && uv.length !== this.surfaceUv.length)) return;
+    let shown = this.surfaceUv;
+    if (uv) {
+      shown = new Float32Array(uv.length);
+      for (let i = 0; i < uv.length; i++) shown[i] = uv[i]! / CHECKER_SQUARES;
+    }
+    this.uvMesh.geometry.setAttribute('uv', new THREE.BufferAttribute(shown, 2));
+    this.gridUvShown = uv !== null;
+    this.loop.request();
+  }
+
+  /** True while checker mode draws integer-grid UVs (see `setGridUv`). */
+  get showsGridUv(): boolean {
+    return this.gridUvShown;
+  }
+
+  /** Shows or hides the cone and boundary-corner markers (they would cover the quad mesh's singular vertices). */
+  setConesVisible(visible: boolean): void {
+    this.markers.visible = visible;
+    this.loop.request();
+  }
+
+  /**
+   * Puts `object` in the scene as overlay `name` (in mesh coordinates),
+   * replacing and disposing the one shown under that name (its geometries
+   * and materials); null removes it.
+   */
+  setOverlay(name: string, object: THREE.Object3D | null): void {
+    const old = this.overlays.get(name);
+    if (old) {
+      this.group.remove(old);
+      old.traverse((o) => {
+        const m = o as THREE.Mesh;
+        m.geometry?.dispose();
+        for (const mat of [m.material ?? []].flat()) mat.dispose();
+      });
+      this.overlays.delete(name);
+    }
+    if (object) {
+      this.overlays.set(name, object);
+      this.group.add(object);
+    }
+    if (old || object) this.loop.request();
   }
 
   setSurfaceMode(mode: SurfaceMode): void {
@@ -437,6 +497,8 @@ export class Viewer {
     this.setAnchor(null);
     this.setProblemVertices([]);
     this.setHoverFace(null);
+    for (const name of [...this.overlays.keys()]) this.setOverlay(name, null);
+    this.markers.visible = true;
     for (const obj of [this.mesh, this.wire]) {
       if (!obj) continue;
       this.group.remove(obj);

@@ -6,8 +6,9 @@
 //
 // Solves run in steps (see protocol.ts): on large meshes a short-lived helper
 // worker opens the same mesh and places some of the cut mesh's components
-// (they are independent), which halves the cone stage on two cores.
-import type { ErrorLocation, ImportResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
+// (they are independent), which halves the cone stage on two cores. Quads are
+// asked of the worker that finished the solve (its session keeps the map).
+import type { ErrorLocation, ImportResult, QuadsResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
 import type { SolveTuning } from './state';
 
 export class WorkerCrashed extends Error {
@@ -59,6 +60,8 @@ export class MeshWorker {
   private helper: MeshWorker | null = null;
   /** Terminated for good (helpers are never replaced). */
   private disposed = false;
+  /** `restarts` when the last solve finished in this worker (null: no solve since the mesh was opened). */
+  private solvedIn: number | null = null;
   /** How many times a dead worker was replaced (for the test hooks). */
   restarts = 0;
 
@@ -160,6 +163,7 @@ export class MeshWorker {
     );
     this.openFiles = kept;
     this.openFaces = result.indices.length / 3;
+    this.solvedIn = null;
     return result;
   }
 
@@ -180,6 +184,7 @@ export class MeshWorker {
    */
   async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn, freeBoundary: boolean, tuning: Readonly<SolveTuning>): Promise<SolveResult> {
     const generation = this.restarts;
+    this.solvedIn = null; // a solve begun drops the session's last map, whatever its outcome
     /** Throws `Cancelled` once this worker was replaced (cancel or crash) since the solve began. */
     const alive = (): void => {
       if (this.restarts !== generation) throw new Cancelled('cancelled');
@@ -246,10 +251,26 @@ export class MeshWorker {
       }
       alive();
       const result = await this.send<SolveResult>({ type: 'solve-finish' }, [], placing);
+      this.solvedIn = this.restarts;
       return { ...result, helperComponents: helped };
     } finally {
       if (helper && this.helper === helper.worker) this.dropHelper();
     }
+  }
+
+  /**
+   * The integer-grid map and quad mesh of the last solve for about `quads`
+   * grid cells, from the worker whose session finished it (only quantization
+   * and extraction run). Rejects when the last solve did not succeed, or the
+   * worker was replaced since (its session, and the map, are gone), and with the
+   * library's error when quantization fails; `onProgress` gets the stages
+   * 'quantization' (forms rounded, forms) and 'quad extraction'.
+   */
+  quads(quads: number, onProgress: ProgressFn = () => {}): Promise<QuadsResult> {
+    if (this.solvedIn !== this.restarts) {
+      return Promise.reject(new Error('the solver holds no solved map (a solve since failed, was cancelled, or the worker was restarted): Run again to get quads'));
+    }
+    return this.send<QuadsResult>({ type: 'quads', quads }, [], onProgress);
   }
 
   /** A helper for a solve of `schedule`'s components, or null when one would not pay (fewer than `minFaces` faces, one component, one core). */

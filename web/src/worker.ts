@@ -1,10 +1,10 @@
 // Module Web Worker: the only place the wasm runs. Receives `Request`s, answers
 // with `Response`s (see protocol.ts); result buffers are transferred, not copied.
 // Keeps the last opened mesh as a `MeshSession` so that sharp-edge queries and
-// solves do not re-import it.
+// solves do not re-import it, and quads re-use the session's last solve.
 import init, { MeshSession, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { ErrorLocation, ImportResult, MeshReport, Request, Response, SharpResult, SolveResult, SolveView, WasmSolveResult } from './protocol';
+import type { ErrorLocation, ImportResult, MeshReport, QuadsResult, Request, Response, SharpResult, SolveResult, SolveView, WasmSolveResult } from './protocol';
 import { buildSolveView, viewBuffers } from './solve-view';
 import { buildAdjacency, faceEdges } from './topology';
 
@@ -35,6 +35,8 @@ interface Session {
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
   solve_add(bytes: Uint8Array): void;
   solve_finish(progress: Progress): WasmSolveResult;
+  /** The integer-grid map and quad mesh of the last solve for about `quads` cells; throws before a solve. */
+  quads(quads: number, progress: Progress): QuadsResult;
   free(): void;
 }
 let session: Session | null = null;
@@ -114,13 +116,15 @@ function requireSession(): Session {
   return session;
 }
 
-/** A progress callback that posts at most every 30 ms (rounding can call it thousands of times). */
+/** A progress callback that posts at most every 30 ms within a stage (rounding can call it thousands of times), and every change of stage. */
 function throttledProgress(id: number): Progress {
   let lastPost = 0;
+  let lastStage = '';
   return (stage, step, remaining) => {
     const now = performance.now();
-    if (now - lastPost < 30) return;
+    if (stage === lastStage && now - lastPost < 30) return;
     lastPost = now;
+    lastStage = stage;
     post({ id, type: 'progress', stage, step, remaining });
   };
 }
@@ -159,6 +163,15 @@ function solveAnswer(s: Session, solved: WasmSolveResult, t0: number): Answer {
     if (v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
   }
   return { value, transfer };
+}
+
+/** A `QuadsResult` with its arrays to transfer. */
+function quadsAnswer(r: QuadsResult): Answer {
+  const transfer: Transferable[] = [];
+  for (const v of [r.uv, r.positions, r.quads, r.edges, r.singular, r.obj, r.glb, r.grid_glb]) {
+    if (v.buffer instanceof ArrayBuffer && !transfer.includes(v.buffer)) transfer.push(v.buffer);
+  }
+  return { value: r, transfer };
 }
 
 /**
@@ -208,6 +221,9 @@ async function handle(req: Request): Promise<void> {
       case 'solve-add':
       case 'solve-finish':
         out = solveStep(req);
+        break;
+      case 'quads':
+        out = quadsAnswer(requireSession().quads(req.quads, throttledProgress(id)));
         break;
     }
     post({ id, type: 'result', value: out.value }, out.transfer);

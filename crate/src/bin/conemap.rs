@@ -6,6 +6,7 @@
 use conemap::cones::{self, BoundaryMode, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;
 use conemap::mesh::{analyze, MeshReport, TriMesh};
+use conemap::param::quantize::{GridSize, IntegerGridMap, QuantizeReport};
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -15,10 +16,14 @@ macro_rules! println {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
         if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
-            stdout_failed(e)
+            $crate::stdout_failed(e)
         }
     }};
 }
+
+// After the `println!` above, which it uses too.
+#[path = "conemap/quads.rs"]
+mod quads;
 
 /// Exits after a failed write to standard output: silently (status 0) when
 /// the reader went away, else with the error on standard error (status 1).
@@ -78,6 +83,22 @@ commands:
                        fields plus metrics and per-stage timings).
                        --checker: embed a checkerboard texture (glTF),
                        squares of 2^-k UV units (at least 16 across).
+                       --grid S / --quads N: make the map an integer-grid
+                       map of cell S (model units), or of about N cells:
+                       cones on integer points, features and boundary on
+                       integer isolines, seam translations integers. UVs
+                       are then in grid units (one cell = 1.0, shifted by
+                       an integer only) and the checker square is a cell.
+
+  quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG]
+             [--features FEATURES.json] [--report REPORT.json] [cone options]
+                       the quad mesh of the integer-grid map (default
+                       --quads 3000): OBJ with quad faces and the grid
+                       coordinates of each corner as vt; glTF with each quad
+                       as two triangles plus the quad edges as LINES.
+                       --report: quads, singular vertices by valence,
+                       corner-angle statistics, distortion before and after
+                       quantization, defects and per-stage timings.
 
 options:
   -h, --help           print this help
@@ -106,6 +127,26 @@ const COMMANDS: &[(&str, &[&str])] = &[
             "--features=",
             "--boundary=",
             "--report=",
+            "--grid=",
+            "--quads=",
+            "-o=",
+            "--output=",
+        ],
+    ),
+    (
+        "quads",
+        &[
+            "--quiet",
+            "--miq",
+            "--no-moves",
+            "--closed-features",
+            "--alpha=",
+            "--sharp=",
+            "--min-feature-length=",
+            "--features=",
+            "--report=",
+            "--quad-size=",
+            "--quads=",
             "-o=",
             "--output=",
         ],
@@ -148,6 +189,7 @@ fn run(args: &[String]) -> Result<(), Failure> {
                 "info" => info_command(&parsed),
                 "cones" => cones_command(&parsed),
                 "solve" => solve_command(&parsed),
+                "quads" => quads::quads_command(&parsed),
                 _ => unreachable!("command listed in COMMANDS without a handler"),
             }
         }
@@ -495,7 +537,6 @@ fn print_cones(file: &str, mesh: &TriMesh, features: &FeatureSet, options: &Cone
 fn solve_command(args: &Args) -> Result<(), Failure> {
     use conemap::export::{self, ExportInput, ExportOptions, Format};
     use conemap::mesh::RawMesh;
-    use conemap::pipeline::{self, SolveOptions};
 
     let file = args.file()?;
     let out = args.value("-o").or_else(|| args.value("--output")).ok_or_else(|| usage("solve needs -o OUT"))?;
@@ -503,25 +544,24 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
         return Err(usage(&format!("{out}: unknown output format (use .glb, .gltf or .obj)")));
     };
     let options = cone_options(args)?;
+    let grid = grid_option(args, "--grid")?;
     // Fail before the long computation when the output cannot be created.
     check_writable([Some(out), args.value("--report")].into_iter().flatten())?;
 
     let mut clock = conemap::clock::Stopwatch::start();
     let input_file = read_input(file)?;
     let mut times = SolveTimes { import: clock.lap(), ..SolveTimes::default() };
-
     let features = load_features(args, &input_file.mesh)?;
-    let solve_options = SolveOptions { cones: options, ..SolveOptions::default() };
-    let bar = ProgressLine::new(args);
-    let solution = pipeline::solve(&input_file.mesh, &features, &solve_options, &mut |p| match p {
-        pipeline::SolveProgress::Cones(p) => bar.cones(&p),
-        pipeline::SolveProgress::Param(p) => bar.param(&p),
-    });
-    bar.finish();
-    let solution = solution.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let solution = solve_mesh(args, file, &input_file.mesh, &features, options)?;
     let alignment = solution.feature_alignment(&input_file.mesh, &features);
     times.cones = solution.refine_seconds + solution.placement.timings.total;
     times.param = clock.lap() - times.cones;
+    let grid_map = match grid {
+        Some(size) => Some(quantize(file, &solution, size)?),
+        None => None,
+    };
+    times.quantize = clock.lap();
+    let uv = grid_map.as_ref().map(|g| &g.uv).unwrap_or(&solution.param.uv);
 
     // Splitting doubly constrained triangles adds vertices: export the refined
     // mesh then (its source attributes are not carried over).
@@ -532,24 +572,80 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     } else {
         (&input_file.raw, input_file.source.as_ref())
     };
-    let mut input = ExportInput::new(raw_used, &solution.mesh, &solution.param.uv).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let mut input = ExportInput::new(raw_used, &solution.mesh, uv).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     if let Some(source) = source_used {
         input = input.with_gltf_source(source, &input_file.main, &input_file.others);
     }
     let stem = Path::new(file).file_stem().map(|s| s.to_string_lossy().into_owned());
-    let export_options = ExportOptions { checker: args.flag("--checker"), name: stem, ..ExportOptions::default() };
+    let export_options = ExportOptions {
+        checker: args.flag("--checker"),
+        checker_cell: grid_map.as_ref().map(|_| 1.0),
+        name: stem,
+        grid_units: grid_map.is_some(),
+    };
     let data = export::export(&input, format, &export_options);
     std::fs::write(out, &data).map_err(|e| Failure(format!("{out}: cannot write: {e}"), 1))?;
     times.export = clock.lap();
 
-    let written = Written { path: out, format, input: &input, bytes: data.len() };
+    let written = Written { path: out, format, input: &input, options: &export_options, bytes: data.len() };
     if let Some(path) = args.value("--report") {
-        let report = solve_report(&solution, &options, &alignment, &written, &times);
+        let mut report = solve_report(&solution, &options, &alignment, &written, &times);
+        if let Some(g) = &grid_map {
+            report["quantization"] = serde_json::json!(g.report);
+        }
         let text = serde_json::to_string_pretty(&report).map_err(|e| Failure(e.to_string(), 1))?;
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
     }
     print_solution(file, &solution, &alignment, &written, &times);
+    if let Some(g) = &grid_map {
+        print_quantization(&g.report);
+    }
     Ok(())
+}
+
+/// Places cones and parametrizes `mesh` (read from `file`) with the cone
+/// options of `args`, showing progress on a terminal.
+fn solve_mesh<'a>(args: &Args, file: &str, mesh: &'a TriMesh, features: &'a FeatureSet, options: ConeOptions) -> Result<conemap::pipeline::Solution<'a>, Failure> {
+    use conemap::pipeline::{self, SolveOptions};
+    let solve_options = SolveOptions { cones: options, ..SolveOptions::default() };
+    let bar = ProgressLine::new(args);
+    let solution = pipeline::solve(mesh, features, &solve_options, &mut |p| match p {
+        pipeline::SolveProgress::Cones(p) => bar.cones(&p),
+        pipeline::SolveProgress::Param(p) => bar.param(&p),
+    });
+    bar.finish();
+    solution.map_err(|e| Failure(format!("{file}: {e}"), 1))
+}
+
+/// The grid size of `--grid S` / `--quad-size S` (`flag`) or `--quads N`; `None` when neither is given.
+fn grid_option(args: &Args, flag: &str) -> Result<Option<GridSize>, Failure> {
+    let size = args.number(flag)?;
+    let quads = args.number("--quads")?;
+    match (size, quads) {
+        (Some(_), Some(_)) => Err(usage(&format!("give {flag} or --quads, not both"))),
+        (Some(s), None) if s > 0.0 && s.is_finite() => Ok(Some(GridSize::Length(s))),
+        (Some(s), None) => Err(usage(&format!("{flag} expects a positive length, got {s}"))),
+        (None, Some(n)) if n >= 1.0 && n.fract() == 0.0 && n <= 1e8 => Ok(Some(GridSize::Quads(n as usize))),
+        (None, Some(n)) => Err(usage(&format!("--quads expects a whole number of quads, got {n}"))),
+        (None, None) => Ok(None),
+    }
+}
+
+/// The integer-grid map of `solution` for grid size `size`.
+fn quantize(file: &str, solution: &conemap::pipeline::Solution, size: GridSize) -> Result<IntegerGridMap, Failure> {
+    let quantizer = solution.quantizer().map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    quantizer.quantize(&solution.mesh, size, &mut |_, _| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))
+}
+
+/// The summary of a quantization.
+fn print_quantization(r: &QuantizeReport) {
+    println!(
+        "  integer grid: cell {:.4} ({:.0} cells), {} point and {} translation integers in {} batches, distortion {:.4} -> {:.4}, flipped {}, integer residual {:.1e}",
+        r.grid_size, r.cells, r.point_forms, r.translation_forms, r.batches, r.distortion_before, r.distortion_after, r.flipped, r.integer_residual
+    );
+    if r.conflicts > 0 {
+        println!("  warning: {} integers could not be met (determined by others at a non-integer value)", r.conflicts);
+    }
 }
 
 /// Fails when a file cannot be created at one of `paths` (missing directory,
@@ -602,12 +698,13 @@ struct SolveTimes {
     import: f64,
     cones: f64,
     param: f64,
+    quantize: f64,
     export: f64,
 }
 
 impl SolveTimes {
     fn total(&self) -> f64 {
-        self.import + self.cones + self.param + self.export
+        self.import + self.cones + self.param + self.quantize + self.export
     }
 }
 
@@ -616,6 +713,7 @@ struct Written<'a> {
     path: &'a str,
     format: conemap::export::Format,
     input: &'a conemap::export::ExportInput<'a>,
+    options: &'a conemap::export::ExportOptions,
     bytes: usize,
 }
 
@@ -649,7 +747,7 @@ fn solve_report(
         "vertices": input.output_vertex_count(),
         "faces": mesh.n_faces(),
         "bytes": written.bytes,
-        "uv_normalization": {"offset": input.uv_normalization().offset, "scale": input.uv_normalization().scale},
+        "uv_normalization": {"offset": input.uv_normalization(written.options).offset, "scale": input.uv_normalization(written.options).scale},
         "notes": input.notes(),
     });
     report["timings"] = serde_json::json!({
@@ -659,6 +757,7 @@ fn solve_report(
         "cones_total": times.cones,
         "param": result.timings,
         "param_total": times.param,
+        "quantize": times.quantize,
         "export": times.export,
         "total": times.total(),
     });

@@ -8,7 +8,7 @@
 //! `uv_scale`: `TEXCOORD_0 = ((u − offset_u) scale, 1 − (v − offset_v) scale)`)
 //! and any notes about dropped source data.
 
-use super::{generator, ExportInput, ExportOptions, UvNormalization};
+use super::{generator, ExportInput, ExportOptions};
 use base64::Engine;
 use serde_json::{json, Value};
 
@@ -99,7 +99,9 @@ impl GltfBuffer {
         self.accessors.len() - 1
     }
 
-    fn floats<const N: usize>(&mut self, values: &[[f32; N]], with_bounds: bool) -> usize {
+    /// A FLOAT `VECN` (or SCALAR) accessor over `values` in a new
+    /// bufferView, with `min` / `max` when `with_bounds`; returns its index.
+    pub fn floats<const N: usize>(&mut self, values: &[[f32; N]], with_bounds: bool) -> usize {
         let bytes: Vec<u8> = values.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
         let view = self.view(&bytes, Some(ARRAY_BUFFER), None);
         let kind = match N {
@@ -123,16 +125,18 @@ impl GltfBuffer {
         }
         self.accessor(a)
     }
-    fn indices(&mut self, triangles: &[[u32; 3]], vertex_count: usize) -> usize {
+    /// A SCALAR index accessor over `indices` of `vertex_count` vertices
+    /// (u16 when they fit, else u32) in a new bufferView; returns its index.
+    pub fn indices(&mut self, indices: &[u32], vertex_count: usize) -> usize {
         // 65535 is the primitive restart value for u16, so it must not occur.
         let (bytes, component): (Vec<u8>, u32) = if vertex_count <= 65535 {
-            (triangles.iter().flatten().flat_map(|&i| (i as u16).to_le_bytes()).collect(), UNSIGNED_SHORT)
+            (indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect(), UNSIGNED_SHORT)
         } else {
-            (triangles.iter().flatten().flat_map(|&i| i.to_le_bytes()).collect(), UNSIGNED_INT)
+            (indices.iter().flat_map(|&i| i.to_le_bytes()).collect(), UNSIGNED_INT)
         };
         let view = self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER), None);
         self.accessor(json!({
-            "bufferView": view, "componentType": component, "count": 3 * triangles.len(), "type": "SCALAR"
+            "bufferView": view, "componentType": component, "count": indices.len(), "type": "SCALAR"
         }))
     }
 }
@@ -142,7 +146,7 @@ impl GltfBuffer {
 fn document(input: &ExportInput, options: &ExportOptions, embed: bool) -> (Value, Vec<u8>) {
     let layout = input.layout();
     let normals = input.normals();
-    let norm = UvNormalization::of(input.uv);
+    let norm = input.uv_normalization(options);
     let mut bin = GltfBuffer::default();
 
     // Materials: the source's (factors only), plus a checker material for
@@ -181,7 +185,7 @@ fn document(input: &ExportInput, options: &ExportOptions, embed: bool) -> (Value
         let p = bin.floats(&positions, true);
         let n = bin.floats(&normal, false);
         let t = bin.floats(&uv, false);
-        let i = bin.indices(&g.triangles, g.wedges.len());
+        let i = bin.indices(g.triangles.as_flattened(), g.wedges.len());
         let mut prim = json!({
             "attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": t},
             "indices": i,

@@ -46,6 +46,7 @@
 //! the normalised unit square instead.
 
 mod glb;
+pub mod quads;
 mod obj;
 mod png;
 mod source;
@@ -96,6 +97,10 @@ pub struct ExportOptions {
     pub checker_cell: Option<f64>,
     /// Name of the output mesh and node (glTF) or object (OBJ).
     pub name: Option<String>,
+    /// Write the UVs in grid units (an integer-grid map: one grid cell is
+    /// 1.0), shifted by an integer vector only, instead of normalised to the
+    /// unit square; the checker square is then one cell.
+    pub grid_units: bool,
 }
 
 /// Input that cannot be exported.
@@ -166,6 +171,17 @@ impl UvNormalization {
         }
         cell
     }
+    /// The integer shift that centres a grid-unit UV set near the origin
+    /// (scale 1): integer translations keep an integer-grid map one, and
+    /// small coordinates keep the f32 of glTF exact to about 1e-6.
+    pub fn grid(uv: &[[f64; 2]]) -> UvNormalization {
+        if uv.is_empty() {
+            return UvNormalization { offset: [0.0, 0.0], scale: 1.0 };
+        }
+        let (lo, hi) = crate::vec3::bounds(uv);
+        let centre = [0, 1].map(|k| (0.5 * (lo[k] + hi[k])).round());
+        UvNormalization { offset: if centre.iter().all(|c| c.is_finite()) { centre } else { [0.0, 0.0] }, scale: 1.0 }
+    }
     /// `(u', v')` in `[0, 1]²`, origin bottom-left (the OBJ `vt`).
     pub fn apply(&self, uv: [f64; 2]) -> [f64; 2] {
         [(uv[0] - self.offset[0]) * self.scale, (uv[1] - self.offset[1]) * self.scale]
@@ -234,9 +250,13 @@ impl<'a> ExportInput<'a> {
         self.layout().groups.iter().map(|g| g.wedges.len()).sum()
     }
 
-    /// The UV normalisation the writers apply.
-    pub fn uv_normalization(&self) -> UvNormalization {
-        UvNormalization::of(self.uv)
+    /// The UV normalisation the writers apply with `options`.
+    pub fn uv_normalization(&self, options: &ExportOptions) -> UvNormalization {
+        if options.grid_units {
+            UvNormalization::grid(self.uv)
+        } else {
+            UvNormalization::of(self.uv)
+        }
     }
 
     /// Output position of source vertex `s`: that of its welded vertex, so

@@ -10,14 +10,14 @@
 //! * `f v/vt/vn` per triangle, in input order; `g` per output group when
 //!   there is more than one.
 
-use super::{generator, ExportInput, ExportOptions, UvNormalization};
+use super::{generator, ExportInput, ExportOptions};
 use std::fmt::Write;
 
 /// The OBJ text of `input`.
 pub fn write_obj(input: &ExportInput, options: &ExportOptions) -> String {
     let layout = input.layout();
     let normals = input.normals();
-    let norm = UvNormalization::of(input.uv);
+    let norm = input.uv_normalization(options);
     let raw = input.raw;
     let s2w = input.mesh.source_to_welded();
     let per_source_normals = input.source.as_ref().is_some_and(|s| s.normals.iter().any(Option::is_some));

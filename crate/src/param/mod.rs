@@ -5,6 +5,9 @@
 //! the untangling of what the repair left flipped ([`untangle`]), an
 //! injective (flip-free) refinement under the same constraints
 //! ([`injective`]), and the quality figures of section 7 ([`metrics`], eq. 19).
+//! After it, [`quantize`] turns the map into an integer-grid map for a grid
+//! size (the paper's Limitations), reusing the seamless system's unknowns and
+//! seam rows.
 //! The four share the linear triangle element of [`element`] (face frames,
 //! hat gradients, Jacobians, UV areas and angles) and import no one else's
 //! internals: `seamless` drives `injective` and `untangle`, and measures
@@ -28,6 +31,7 @@ pub mod element;
 pub mod field;
 pub mod injective;
 pub mod metrics;
+pub mod quantize;
 pub mod seamless;
 pub mod untangle;
 #[cfg(test)]

@@ -72,26 +72,6 @@ struct System {
 }
 
 impl System {
-    fn a_triplets(elements: &[Element], weights: &[f64]) -> Vec<Triplet> {
-        let mut t = Vec::with_capacity(elements.len() * 18);
-        for (el, &wt) in elements.iter().zip(weights) {
-            for a in 0..3 {
-                for b in 0..3 {
-                    // Stiffness of (23): A_f grad(phi_a) . grad(phi_b) (full
-                    // matrix given; the strictly lower half is ignored).
-                    let v = wt * el.area * (el.g[a][0] * el.g[b][0] + el.g[a][1] * el.g[b][1]);
-                    for c in 0..2 {
-                        let (i, j) = (el.x[c][a], el.x[c][b]);
-                        if i <= j {
-                            t.push((i, j, v));
-                        }
-                    }
-                }
-            }
-        }
-        t
-    }
-
     /// The factorization ([`LinalgError::NotFactorized`] once released).
     fn solver(&self) -> Result<&LdltSolver, ParamError> {
         self.solver.as_ref().ok_or(ParamError::Solve(LinalgError::NotFactorized))
@@ -154,7 +134,7 @@ impl System {
     }
 
     fn refactor(&mut self, weights: &[f64]) -> Result<(), ParamError> {
-        let a = Self::a_triplets(&self.elements, weights);
+        let a = stiffness_triplets(&self.elements, weights);
         self.kkt.refill(&a, &self.constraints)?;
         let solver = self.solver.as_mut().ok_or(ParamError::Solve(LinalgError::NotFactorized))?;
         solver.factorize(&self.kkt.values)?;
@@ -185,6 +165,49 @@ impl System {
     fn jacobian(&self, f: usize, uv: &[[f64; 2]]) -> [[f64; 2]; 2] {
         self.elements[f].wedge_jacobian(uv)
     }
+}
+
+/// Upper triangle of the stiffness of (23) with per-face weights.
+pub(super) fn stiffness_triplets(elements: &[Element], weights: &[f64]) -> Vec<Triplet> {
+    let mut t = Vec::with_capacity(elements.len() * 18);
+    for (el, &wt) in elements.iter().zip(weights) {
+        for a in 0..3 {
+            for b in 0..3 {
+                // Stiffness of (23): A_f grad(phi_a) . grad(phi_b) (full
+                // matrix given; the strictly lower half is ignored).
+                let v = wt * el.area * (el.g[a][0] * el.g[b][0] + el.g[a][1] * el.g[b][1]);
+                for c in 0..2 {
+                    let (i, j) = (el.x[c][a], el.x[c][b]);
+                    if i <= j {
+                        t.push((i, j, v));
+                    }
+                }
+            }
+        }
+    }
+    t
+}
+
+/// The LDLᵀ of a seamless-map KKT, analysed and factorized. Small
+/// regularization: the constraint pivots are exact zeros before their primal
+/// neighbours are eliminated; a smaller delta refines faster here.
+pub(super) fn factored(kkt: &Kkt) -> Result<LdltSolver, LinalgError> {
+    let options = FactorOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..FactorOptions::default() };
+    let mut solver = LdltSolver::with_options(&kkt.pattern, &kkt.signs, options)?;
+    solver.factorize(&kkt.values)?;
+    Ok(solver)
+}
+
+/// One linear element per face on the wedges of `cut` and unknowns `vars`.
+pub(super) fn elements(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2]) -> Vec<Element> {
+    (0..mesh.n_faces() as u32)
+        .map(|f| {
+            let (q, area) = local_triangle(mesh, f);
+            let c = 3 * f as usize;
+            let w = [0, 1, 2].map(|k| cut.wedge[c + k] as usize);
+            Element::new(q, area, w, [w.map(|i| vars[0][i]), w.map(|i| vars[1][i])])
+        })
+        .collect()
 }
 
 /// Closest rotation to `j` (Appendix B.2, local step): `B = ½[[a+d, b-c], [c-b, a+d]]`,
@@ -265,26 +288,12 @@ impl System {
         let nf = mesh.n_faces();
         let nw = cut.n_wedges;
         let (vars, n_unknowns) = unknowns(mesh, field, cut);
-        let elements: Vec<Element> = (0..nf as u32)
-            .map(|f| {
-                let (q, area) = local_triangle(mesh, f);
-                let c = 3 * f as usize;
-                let w = [0, 1, 2].map(|k| cut.wedge[c + k] as usize);
-                Element::new(q, area, w, [w.map(|i| vars[0][i]), w.map(|i| vars[1][i])])
-            })
-            .collect();
+        let elements = elements(mesh, cut, &vars);
 
         let (constraints, n_rows) = constraint_rows(mesh, cut, &vars, n_unknowns);
-        let a = System::a_triplets(&elements, &vec![1.0; nf]);
+        let a = stiffness_triplets(&elements, &vec![1.0; nf]);
         let kkt = Kkt::assemble(&a, n_unknowns, &constraints, n_rows)?;
-        let mut solver = LdltSolver::with_options(
-            &kkt.pattern,
-            &kkt.signs,
-            // Small regularization: the constraint pivots are exact zeros before
-            // their primal neighbours are eliminated; a smaller delta refines faster here.
-            FactorOptions { delta: 1e-11, max_refinement_steps: 30, accept_residual: 1e-4, ..FactorOptions::default() },
-        )?;
-        solver.factorize(&kkt.values)?;
+        let solver = factored(&kkt)?;
         let projector = NullSpaceProjector::new(&constraints, n_unknowns, n_rows).ok();
         Ok(System { elements, n_wedges: nw, n_unknowns, vars, constraints, n_rows, kkt, solver: Some(solver), projector })
     }
@@ -603,7 +612,7 @@ fn arap(
 /// `v_a = v_b` along every feature and boundary edge, both sides) are
 /// enforced by sharing one unknown per class of equal coordinates, which
 /// also removes the rows they would make redundant.
-fn unknowns(mesh: &TriMesh, field: &CrossField, cut: &CutGraph) -> ([Vec<usize>; 2], usize) {
+pub(super) fn unknowns(mesh: &TriMesh, field: &CrossField, cut: &CutGraph) -> ([Vec<usize>; 2], usize) {
     let nw = cut.n_wedges;
     let mut uf = [UnionFind::new(nw), UnionFind::new(nw)];
     for h in 0..3 * mesh.n_faces() as u32 {
@@ -631,14 +640,18 @@ fn unknowns(mesh: &TriMesh, field: &CrossField, cut: &CutGraph) -> ([Vec<usize>;
     (var, n)
 }
 
-/// Constraint rows on the unknowns of [`unknowns`]: seam transitions (B.2)
-/// and pins; rows that vanish or repeat are dropped.
-fn constraint_rows(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2], n_unknowns: usize) -> (Vec<Triplet>, usize) {
-    let var = |w: u32, c: usize| vars[c][w as usize];
-    let mut rows: Vec<Vec<(usize, i64)>> = Vec::new();
-    let mut n = 0usize;
-    let mut seen: std::collections::HashSet<Vec<(usize, i64)>> = std::collections::HashSet::new();
-    let mut push_row = |entries: &mut Vec<(usize, i64)>, rows: &mut Vec<Vec<(usize, i64)>>, n: &mut usize| {
+/// Integer rows `sum_i c_i x_i = 0`, each stored once: merged, without
+/// zero entries, first coefficient positive.
+#[derive(Default)]
+pub(super) struct RowSet {
+    pub(super) rows: Vec<Vec<(usize, i64)>>,
+    seen: std::collections::HashSet<Vec<(usize, i64)>>,
+}
+
+impl RowSet {
+    /// Adds the row of `entries` (duplicates summed) unless it vanishes or
+    /// is already there (then returns false); clears `entries`.
+    pub(super) fn push(&mut self, entries: &mut Vec<(usize, i64)>) -> bool {
         entries.sort_unstable_by_key(|e| e.0);
         let mut merged: Vec<(usize, i64)> = Vec::new();
         for &(i, v) in entries.iter() {
@@ -650,41 +663,57 @@ fn constraint_rows(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2], n_unk
         merged.retain(|e| e.1 != 0);
         entries.clear();
         if merged.is_empty() {
-            return;
+            return false;
         }
         if merged[0].1 < 0 {
             for e in merged.iter_mut() {
                 e.1 = -e.1;
             }
         }
-        if !seen.insert(merged.clone()) {
-            return;
+        let added = self.seen.insert(merged.clone());
+        if added {
+            self.rows.push(merged);
         }
-        rows.push(merged);
-        *n += 1;
-    };
+        added
+    }
+}
+
+/// Rotation `Rot(-m pi/2)` of a seam curve with matching `m`: `f_g = r f_f + t`.
+pub(super) fn curve_rotation(matching: i64) -> [[i64; 2]; 2] {
+    match matching.rem_euclid(4) {
+        0 => [[1, 0], [0, 1]],
+        1 => [[0, 1], [-1, 0]],
+        2 => [[-1, 0], [0, -1]],
+        _ => [[0, -1], [1, 0]],
+    }
+}
+
+/// Wedge pairs `(f side, g side)` at the vertices of a seam curve, head to
+/// tail (a closed curve's first vertex once).
+pub(super) fn curve_wedge_pairs(mesh: &TriMesh, cut: &CutGraph, curve: &super::cut_graph::SeamCurve) -> Vec<(u32, u32)> {
+    let hs = &curve.halfedges;
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(hs.len() + 1);
+    let t0 = mesh.twin(hs[0]);
+    pairs.push((cut.wedge[hs[0] as usize], cut.wedge[mesh.next(t0) as usize]));
+    for &h in hs {
+        let t = mesh.twin(h);
+        pairs.push((cut.wedge[mesh.next(h) as usize], cut.wedge[t as usize]));
+    }
+    if curve.closed && pairs.first() == pairs.last() {
+        pairs.pop();
+    }
+    pairs
+}
+
+/// The seam transition rows (B.2, translation eliminated) on the unknowns
+/// of [`unknowns`], without pins.
+pub(super) fn seam_rows(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2]) -> RowSet {
+    let var = |w: u32, c: usize| vars[c][w as usize];
+    let mut set = RowSet::default();
     let mut entries = Vec::new();
     for curve in &cut.curves {
-        // r = Rot(-m pi/2): f_g = r f_f + t along the whole curve.
-        let rot: [[i64; 2]; 2] = match curve.matching.rem_euclid(4) {
-            0 => [[1, 0], [0, 1]],
-            1 => [[0, 1], [-1, 0]],
-            2 => [[-1, 0], [0, -1]],
-            _ => [[0, -1], [1, 0]],
-        };
-        let hs = &curve.halfedges;
-        // Wedge pairs (f side, g side) at the vertices of the curve.
-        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(hs.len() + 1);
-        let t0 = mesh.twin(hs[0]);
-        pairs.push((cut.wedge[hs[0] as usize], cut.wedge[mesh.next(t0) as usize]));
-        for &h in hs {
-            let t = mesh.twin(h);
-            pairs.push((cut.wedge[mesh.next(h) as usize], cut.wedge[t as usize]));
-        }
-        if curve.closed && pairs.first() == pairs.last() {
-            pairs.pop();
-        }
-        for win in pairs.windows(2) {
+        let rot = curve_rotation(curve.matching);
+        for win in curve_wedge_pairs(mesh, cut, curve).windows(2) {
             let ((fa, ga), (fb, gb)) = (win[0], win[1]);
             for c in 0..2 {
                 // f_g(b) - f_g(a) = r (f_f(b) - f_f(a))   (B.2, t eliminated).
@@ -696,16 +725,25 @@ fn constraint_rows(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2], n_unk
                         entries.push((var(fa, d), rot[c][d]));
                     }
                 }
-                push_row(&mut entries, &mut rows, &mut n);
+                set.push(&mut entries);
             }
         }
     }
+    set
+}
+
+/// Constraint rows on the unknowns of [`unknowns`]: seam transitions (B.2)
+/// and pins; rows that vanish or repeat are dropped.
+fn constraint_rows(mesh: &TriMesh, cut: &CutGraph, vars: &[Vec<usize>; 2], n_unknowns: usize) -> (Vec<Triplet>, usize) {
+    let mut set = seam_rows(mesh, cut, vars);
+    let mut entries = Vec::new();
     for &p in &cut.pins {
         for c in 0..2 {
-            entries.push((var(p, c), 1));
-            push_row(&mut entries, &mut rows, &mut n);
+            entries.push((vars[c][p as usize], 1));
+            set.push(&mut entries);
         }
     }
+    let rows = set.rows;
     // Drop rows that are combinations of earlier ones (exact redundancy
     // makes the KKT singular); pins come last and are never redundant.
     let keep = independent_rows(&rows, n_unknowns);

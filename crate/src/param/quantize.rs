@@ -1,0 +1,1018 @@
+//! Quantization: the seamless map made an integer-grid map (the paper's
+//! Limitations and Figures 1 and 12; Bommes et al. 2013). For a grid size `s`
+//! (model units) the map is scaled to grid units (`uv / s`), and then
+//! - every singular point (cone, and any boundary or feature corner whose UV
+//!   angle is not straight) lands on an integer point,
+//! - every feature and boundary isoline on an integer `u` or `v`,
+//! - every seam transition's translation becomes an integer vector,
+//!
+//! while the seam rows of (B.2) and the isolines keep holding exactly. The
+//! integer unknowns ("forms": linear forms of the wedge unknowns) are
+//! rounded greedily in the spirit of Algorithm 1: closest to an integer
+//! first, in batches, with the map re-solved after each batch as the
+//! least-squares closest map, `min sum_f A_f |J_f - J_f^0 / s|^2` (the
+//! seamless map's Jacobians `J^0`), under the rounded forms. Interior cones
+//! are rounded first, then boundary and feature corners and isolines, then
+//! translations: a translation across a seam that ends at a cone `p` is
+//! `(I - r) p`, and the two sides of a half-turn seam from a corner `P` to a
+//! cone `p` satisfy `f_g(P) + f_f(P) = 2 p`, so rounding the cone later could
+//! leave it half-way between
+//! grid points. Last, ARAP local/global iterations (eq. 4) under all the
+//! integer rows pull the distortion back down, keeping every step that
+//! leaves no more flipped triangles than the rounding did.
+//!
+//! Cost: one symbolic analysis and numeric factorization of the KKT per
+//! batch (the rows change), about `2 log2(forms)` of them, then one solve
+//! per ARAP iteration with the last factorization.
+
+use super::cut_graph::{cut_graph, CutGraph};
+use super::element::{signed_uv_area, Element};
+use super::field::cross_field;
+use super::metrics;
+use super::seamless::{
+    closest_rotation, curve_rotation, curve_wedge_pairs, elements, factored, seam_rows,
+    stiffness_triplets, unknowns, RowSet,
+};
+use super::untangle::{untangle, UntangleOptions};
+use super::{ParamError, Parametrization};
+use crate::clock::Stopwatch;
+use crate::cones::ConePlacement;
+use crate::linalg::{
+    constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, Triplet,
+};
+use crate::mesh::{TriMesh, UnionFind};
+use serde::Serialize;
+use std::f64::consts::{FRAC_PI_4, PI};
+use std::fmt;
+
+/// Share of the remaining forms of a class rounded per batch.
+const BATCH_FRACTION: f64 = 0.5;
+
+/// A form within this of an integer is rounded in the current batch
+/// whatever its rank (it is usually determined by forms already rounded).
+const NEAR_INTEGER: f64 = 1e-6;
+
+/// Times a batch is solved again with its conflicting forms moved first.
+const MAX_REORDERS: usize = 8;
+
+/// Share of its seamless-map UV area below which a triangle counts as
+/// collapsed (squeezed onto a grid line: the exact snapping of the integers
+/// afterwards makes it degenerate).
+const COLLAPSED_SHARE: f64 = 1e-6;
+
+/// Weight of a wound vertex in [`Quantizer::badness`].
+const WOUND_WEIGHT: usize = 16;
+
+/// Integer moves tried against flipped or collapsed triangles, at most.
+const UNCOLLAPSE_TRIALS: usize = 40;
+
+/// Relative residual of every solve.
+const SOLVE_TOLERANCE: f64 = 1e-12;
+
+/// ARAP iterations after the rounding, at most.
+const ARAP_ITERATIONS: usize = 20;
+
+/// How the grid size is given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GridSize {
+    /// Edge length of a grid cell, in model units.
+    Length(f64),
+    /// About this many grid cells (quads) over the whole map:
+    /// `s = sqrt(map area / N)`.
+    Quads(usize),
+}
+
+/// Why quantization failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum QuantizeError {
+    /// The grid size is not a positive finite length (or the quad count is 0).
+    InvalidGridSize { value: f64 },
+    /// A free boundary (`--boundary free`) lies on no isoline: it cannot be
+    /// put on the grid.
+    FreeBoundary,
+    /// The parametrization does not belong to this mesh and placement.
+    Mismatch { what: &'static str },
+    /// The field, the cut or a solve failed.
+    Param(ParamError),
+}
+
+impl fmt::Display for QuantizeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            QuantizeError::InvalidGridSize { value } => {
+                write!(f, "grid size {value} is not a positive length")
+            }
+            QuantizeError::FreeBoundary => {
+                write!(f, "an integer-grid map needs the boundary on isolines; it was solved with a free boundary")
+            }
+            QuantizeError::Mismatch { what } => {
+                write!(f, "the parametrization does not match the mesh ({what})")
+            }
+            QuantizeError::Param(e) => write!(f, "quantization: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for QuantizeError {}
+
+impl From<ParamError> for QuantizeError {
+    fn from(e: ParamError) -> Self {
+        QuantizeError::Param(e)
+    }
+}
+
+impl From<crate::linalg::LinalgError> for QuantizeError {
+    fn from(e: crate::linalg::LinalgError) -> Self {
+        QuantizeError::Param(ParamError::Solve(e))
+    }
+}
+
+/// What an integer form pins down.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+enum FormKind {
+    /// A coordinate of an interior cone's wedge.
+    Cone,
+    /// A coordinate of a singular boundary or feature point's wedge, or an isoline's constant.
+    Point,
+    /// A component of a seam curve's translation `t = f_g(a) - r f_f(a)`.
+    Translation,
+}
+
+/// A linear form of the unknowns that must take an integer value.
+#[derive(Clone, Debug)]
+struct Form {
+    row: Vec<(usize, i64)>,
+    kind: FormKind,
+    /// Disk component of the cut (index into the pins).
+    component: usize,
+    /// Change of the form under a translation `d` of the whole component: `response · d`.
+    response: [i64; 2],
+}
+
+impl Form {
+    fn value(&self, x: &[f64]) -> f64 {
+        self.row.iter().map(|&(i, c)| c as f64 * x[i]).sum()
+    }
+}
+
+/// Figures of one quantization.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct QuantizeReport {
+    /// Grid cell edge length, model units.
+    pub grid_size: f64,
+    /// Integer forms: singular-point coordinates and isolines, translations.
+    pub point_forms: usize,
+    pub translation_forms: usize,
+    /// Rounding batches (each one KKT analysis + factorization).
+    pub batches: usize,
+    /// Integers moved by one to undo a collapse ([`Quantizer::uncollapse`]).
+    pub moved_integers: usize,
+    /// ARAP iterations kept after the rounding.
+    pub arap_iterations: usize,
+    /// The rounded map had flipped triangles and the untangler removed them all.
+    pub untangled: bool,
+    /// Forms that came out determined by others at a non-integer value (0 on success).
+    pub conflicts: usize,
+    /// Largest distance of a form from its integer after the final solve.
+    pub integer_residual: f64,
+    /// Distortion (eq. 19) of the seamless map and of the integer-grid map.
+    pub distortion_before: f64,
+    pub distortion_after: f64,
+    /// Flipped or degenerate triangles of the integer-grid map.
+    pub flipped: usize,
+    /// Vertices around which the map winds (UV angle sum off the seamless map's by 2 pi).
+    pub wound_vertices: usize,
+    /// Total UV area in grid cells (about the number of quads).
+    pub cells: f64,
+    pub seconds: f64,
+}
+
+/// An integer-grid map: one UV per face corner (`3 f + k`) in grid units.
+#[derive(Clone, Debug)]
+pub struct IntegerGridMap {
+    pub uv: Vec<[f64; 2]>,
+    pub report: QuantizeReport,
+}
+
+/// The fixed part of quantization for one parametrization: unknowns,
+/// elements, seam rows and integer forms (set up once; [`Quantizer::quantize`]
+/// runs for any grid size).
+pub struct Quantizer {
+    wedge: Vec<u32>,
+    elements: Vec<Element>,
+    vars: [Vec<usize>; 2],
+    n_unknowns: usize,
+    seam_rows: Vec<Vec<(usize, i64)>>,
+    forms: Vec<Form>,
+    /// Per form: the triangles' triples of single-unknown forms it is one of,
+    /// one coordinate each (rounding all three to one integer collapses the
+    /// triangle onto a grid line).
+    triples: Vec<Vec<[usize; 3]>>,
+    /// Per component: the pin wedge's two unknowns.
+    pins: Vec<[usize; 2]>,
+    /// The seamless map's unknowns (model units).
+    seamless: Vec<f64>,
+    stiffness: Vec<Triplet>,
+    /// UV area of every face in the seamless map (model units).
+    seamless_areas: Vec<f64>,
+    /// Faces of the mesh (corner `k` of face `f` is unknown column `k` of element `f`).
+    faces: Vec<[u32; 3]>,
+    /// UV angle sum of every vertex in the seamless map: quantization must
+    /// keep it (a vertex off it by 2 pi winds without a flipped triangle).
+    angle_sums: Vec<f64>,
+    map_area: f64,
+    distortion_before: f64,
+}
+
+impl Quantizer {
+    /// Sets up quantization of `param`, the parametrization of `mesh` with
+    /// `placement` (recomputes the field and cut, which are deterministic).
+    pub fn new(
+        mesh: &TriMesh,
+        placement: &ConePlacement,
+        param: &Parametrization,
+    ) -> Result<Quantizer, QuantizeError> {
+        let nf = mesh.n_faces();
+        if param.uv.len() != 3 * nf {
+            return Err(QuantizeError::Mismatch {
+                what: "corner count",
+            });
+        }
+        let cm = &placement.cut.mesh;
+        if (0..cm.n_vertices() as u32).any(|v| placement.cut.touches_free(v)) {
+            return Err(QuantizeError::FreeBoundary);
+        }
+        let field = cross_field(mesh, placement)?;
+        let cut = cut_graph(mesh, placement, &field)?;
+        let (vars, n_unknowns) = unknowns(mesh, &field, &cut);
+        let elements = elements(mesh, &cut, &vars);
+        let mut seamless = vec![0.0; n_unknowns];
+        for (c, &w) in cut.wedge.iter().enumerate() {
+            for k in 0..2 {
+                seamless[vars[k][w as usize]] = param.uv[c][k];
+            }
+        }
+        let component = wedge_components(&cut);
+        let forms = integer_forms(
+            mesh,
+            placement,
+            &field.isoline,
+            &cut,
+            &vars,
+            &component,
+            &param.uv,
+        );
+        let pins = cut
+            .pins
+            .iter()
+            .map(|&p| [vars[0][p as usize], vars[1][p as usize]])
+            .collect();
+        let triples = collapse_triples(&elements, &forms, n_unknowns);
+        let map_area = (0..nf)
+            .map(|f| {
+                signed_uv_area([param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]).max(0.0)
+            })
+            .sum();
+        let faces = mesh.faces().to_vec();
+        let seamless_areas = (0..nf)
+            .map(|f| signed_uv_area([param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]))
+            .collect();
+        let angle_sums = corner_angle_sums(&faces, mesh.n_vertices(), |f| {
+            [param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]
+        });
+        Ok(Quantizer {
+            seamless_areas,
+            faces,
+            angle_sums,
+            seam_rows: seam_rows(mesh, &cut, &vars).rows,
+            wedge: cut.wedge,
+            stiffness: stiffness_triplets(&elements, &vec![1.0; nf]),
+            elements,
+            vars,
+            n_unknowns,
+            forms,
+            triples,
+            pins,
+            seamless,
+            map_area,
+            distortion_before: metrics::distortion(mesh, &param.uv),
+        })
+    }
+
+    /// Grid cell length for `size` (model units).
+    pub fn grid_length(&self, size: GridSize) -> Result<f64, QuantizeError> {
+        let s = match size {
+            GridSize::Length(s) => s,
+            GridSize::Quads(0) => 0.0,
+            GridSize::Quads(n) => (self.map_area / n as f64).sqrt(),
+        };
+        if !(s > 0.0) || !s.is_finite() {
+            return Err(QuantizeError::InvalidGridSize { value: s });
+        }
+        Ok(s)
+    }
+
+    /// The integer-grid map for grid size `size`. Contract: on return every
+    /// seam row holds to solver accuracy, every form is within
+    /// `report.integer_residual` of its integer (about 1e-9 of the grid) and
+    /// the singular points' and isolines' coordinates are exact integers;
+    /// `report.flipped` says whether the map is still free of flips.
+    pub fn quantize(
+        &self,
+        mesh: &TriMesh,
+        size: GridSize,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<IntegerGridMap, QuantizeError> {
+        let mut clock = Stopwatch::start();
+        let s = self.grid_length(size)?;
+        let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
+        let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
+        let mut values: Vec<Option<i64>> = vec![None; self.forms.len()];
+        let mut order: Vec<usize> = Vec::new();
+        let mut x = x0.clone();
+        let mut batches = 0;
+        let mut system = None;
+        for kind in [FormKind::Cone, FormKind::Point, FormKind::Translation] {
+            loop {
+                let mut free: Vec<(f64, usize)> = (0..self.forms.len())
+                    .filter(|&i| values[i].is_none() && self.forms[i].kind == kind)
+                    .map(|i| (distance_to_integer(self.forms[i].value(&x)), i))
+                    .collect();
+                if free.is_empty() {
+                    break;
+                }
+                free.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                let near = free.iter().filter(|f| f.0 < NEAR_INTEGER).count();
+                let take = ((free.len() as f64 * BATCH_FRACTION).ceil() as usize)
+                    .max(near)
+                    .min(free.len());
+                let batch: Vec<usize> = free[..take].iter().map(|f| f.1).collect();
+                let before = order.len();
+                let mut batch = batch;
+                let mut retries = 0;
+                let (solved, dependent) = loop {
+                    for &i in &batch {
+                        values[i] = None;
+                    }
+                    for &i in &batch {
+                        values[i] = Some(self.rounding(i, &values, &x));
+                    }
+                    order.truncate(before);
+                    order.extend(&batch);
+                    let (solved, dependent) = self.solve(&order, &values, &x, &targets)?;
+                    // A candidate the others determine at a non-integer value (a
+                    // dependency with coefficient 1/2 the kind order missed): round
+                    // it first instead, so that it determines them.
+                    let conflicting: Vec<usize> = dependent
+                        .iter()
+                        .copied()
+                        .filter(|&i| {
+                            batch.contains(&i)
+                                && distance_to_integer(self.forms[i].value(&solved.x))
+                                    > NEAR_INTEGER
+                        })
+                        .collect();
+                    if conflicting.is_empty() || retries == MAX_REORDERS {
+                        break (solved, dependent);
+                    }
+                    retries += 1;
+                    batch.retain(|i| !conflicting.contains(i));
+                    batch.splice(0..0, conflicting);
+                };
+                x = solved.x.clone();
+                // A candidate the batch's other forms already determine takes the
+                // value the solve gives it.
+                for i in dependent {
+                    values[i] = Some(self.forms[i].value(&x).round() as i64);
+                }
+                system = Some(solved);
+                batches += 1;
+                progress(
+                    values.iter().filter(|v| v.is_some()).count(),
+                    self.forms.len(),
+                );
+            }
+        }
+        // The rounded map polished (untangled where it folds, then ARAP);
+        // where it is still bad, the same after moving integers off collapses,
+        // keeping whichever ends better.
+        let mut moved_integers = 0;
+        let (mut arap_iterations, mut untangled) = (0, false);
+        if let Some(solved) = system.as_mut() {
+            let (polished, bad, iterations, untangle_ok) =
+                self.polish(x.clone(), solved, &targets, s)?;
+            (x, arap_iterations, untangled) = (polished, iterations, untangle_ok);
+            if bad > 0 && UNCOLLAPSE_TRIALS > 0 {
+                let (mut moved_values, mut moved_x) = (values.clone(), x.clone());
+                let (start, _) = self.solve(&order, &values, &x, &targets)?;
+                moved_x.copy_from_slice(&start.x);
+                let mut moved_system = start;
+                let moves = self.uncollapse(
+                    &order,
+                    &mut moved_values,
+                    &mut moved_x,
+                    &mut moved_system,
+                    &targets,
+                    s,
+                )?;
+                if moves > 0 {
+                    let (polished, moved_bad, iterations, untangle_ok) =
+                        self.polish(moved_x, &moved_system, &targets, s)?;
+                    if moved_bad < bad {
+                        (x, arap_iterations, untangled, values, moved_integers) =
+                            (polished, iterations, untangle_ok, moved_values, moves);
+                    }
+                }
+            }
+        }
+        // Singular points and isolines exactly on the grid (they are single unknowns).
+        for (form, value) in self.forms.iter().zip(&values) {
+            if let (FormKind::Cone | FormKind::Point, [(i, 1)], Some(v)) =
+                (form.kind, form.row.as_slice(), value)
+            {
+                if (x[*i] - *v as f64).abs() < NEAR_INTEGER {
+                    x[*i] = *v as f64;
+                }
+            }
+        }
+        let flipped = self.flipped(&x);
+        let mut conflicts = 0;
+        let mut integer_residual = 0.0f64;
+        for (form, value) in self.forms.iter().zip(&values) {
+            let d = (form.value(&x) - value.unwrap_or(0) as f64).abs();
+            integer_residual = integer_residual.max(d);
+            if d > 1e-6 {
+                conflicts += 1;
+            }
+        }
+        let uv: Vec<[f64; 2]> = self
+            .wedge
+            .iter()
+            .map(|&w| [x[self.vars[0][w as usize]], x[self.vars[1][w as usize]]])
+            .collect();
+        let cells = (0..mesh.n_faces())
+            .map(|f| signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]))
+            .sum();
+        let report = QuantizeReport {
+            grid_size: s,
+            point_forms: self
+                .forms
+                .iter()
+                .filter(|f| f.kind != FormKind::Translation)
+                .count(),
+            translation_forms: self
+                .forms
+                .iter()
+                .filter(|f| f.kind == FormKind::Translation)
+                .count(),
+            batches,
+            moved_integers,
+            arap_iterations,
+            untangled,
+            conflicts,
+            integer_residual,
+            distortion_before: self.distortion_before,
+            distortion_after: metrics::distortion(mesh, &uv),
+            flipped,
+            wound_vertices: self.wound_vertices(&x).len(),
+            cells,
+            seconds: clock.lap(),
+        };
+        Ok(IntegerGridMap { uv, report })
+    }
+
+    /// The integer form `i` is rounded to: the nearest, unless that puts a
+    /// triangle whose three corners lie on rounded forms of one coordinate
+    /// (two feature isolines less than a cell apart, say) onto one grid
+    /// line; then the next integer on `i`'s side of the others.
+    fn rounding(&self, i: usize, values: &[Option<i64>], x: &[f64]) -> i64 {
+        let y = self.forms[i].value(x);
+        let v = y.round() as i64;
+        for triple in &self.triples[i] {
+            let others: Vec<usize> = triple.iter().copied().filter(|&j| j != i).collect();
+            if !others.iter().all(|&j| values[j] == Some(v)) {
+                continue;
+            }
+            let (lo, hi) = others
+                .iter()
+                .map(|&j| self.forms[j].value(x))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| {
+                    (l.min(y), h.max(y))
+                });
+            if y > hi {
+                return v + 1;
+            } else if y < lo {
+                return v - 1;
+            }
+        }
+        v
+    }
+
+    /// Untangles `x` under `system`'s rows when it folds, then runs ARAP
+    /// local/global iterations (eq. 4), each step kept unless it makes the
+    /// map worse by [`Self::badness`]. Returns the map, its badness, the ARAP
+    /// iterations kept and whether the untangling left no fold.
+    fn polish(
+        &self,
+        mut x: Vec<f64>,
+        system: &RoundedSystem,
+        targets: &[[[f64; 2]; 2]],
+        s: f64,
+    ) -> Result<(Vec<f64>, usize, usize, bool), QuantizeError> {
+        let mut bad = self.badness(&x, s);
+        let mut arap_iterations = 0;
+        let mut untangled = false;
+        if bad > 0 {
+            // Untangle in model units (the barrier's area term wants det J ~ 1).
+            let projector =
+                NullSpaceProjector::new(&system.c, self.n_unknowns, system.b.len()).ok();
+            let precondition = |q: &mut [f64]| system.precondition(q, projector.as_ref());
+            let mut xm: Vec<f64> = x.iter().map(|v| v * s).collect();
+            let stats = untangle(
+                &self.elements,
+                &precondition,
+                &mut xm,
+                &UntangleOptions::default(),
+            );
+            let candidate = system.onto_constraints(xm.iter().map(|v| v / s).collect())?;
+            let f = self.badness(&candidate, s);
+            if f < bad {
+                x = candidate;
+                bad = f;
+                untangled = stats.inverted == 0 && f == 0;
+            }
+        }
+        for _ in 0..ARAP_ITERATIONS {
+            let r: Vec<[[f64; 2]; 2]> = self
+                .elements
+                .iter()
+                .zip(targets)
+                .map(|(el, t)| {
+                    closest_rotation(el.jacobian(&x))
+                        .map(|r| r.map(|row| row.map(|v| v / s)))
+                        .unwrap_or(*t)
+                })
+                .collect();
+            let next = system.resolve(self, &r)?;
+            let f = self.badness(&next, s);
+            if f > bad {
+                break;
+            }
+            let moved = next
+                .iter()
+                .zip(&x)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            x = next;
+            bad = f;
+            arap_iterations += 1;
+            if moved < 1e-4 {
+                break;
+            }
+        }
+        Ok((x, bad, arap_iterations, untangled))
+    }
+
+    /// Where the rounded map has flipped or collapsed triangles, moves the
+    /// integers of the forms at their corners by one, one at a time, keeping
+    /// each move that leaves fewer of them (the collapse of two isolines or
+    /// cones onto one grid line is undone by putting one of them a line
+    /// further). One factorization per trial; at most [`UNCOLLAPSE_TRIALS`].
+    /// Returns the moves kept.
+    fn uncollapse(
+        &self,
+        order: &[usize],
+        values: &mut [Option<i64>],
+        x: &mut Vec<f64>,
+        system: &mut RoundedSystem,
+        targets: &[[[f64; 2]; 2]],
+        s: f64,
+    ) -> Result<usize, QuantizeError> {
+        let mut flipped = self.flipped_faces(x, s);
+        let mut badness = self.badness(x, s);
+        let (mut trials, mut kept) = (0, 0);
+        let mut tried = std::collections::HashSet::new();
+        while !flipped.is_empty() && trials < UNCOLLAPSE_TRIALS {
+            let mut unknowns: Vec<usize> = flipped
+                .iter()
+                .flat_map(|&f| self.elements[f].x.iter().flatten().copied())
+                .collect();
+            unknowns.sort_unstable();
+            unknowns.dedup();
+            let candidates: Vec<usize> = order
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    self.forms[i]
+                        .row
+                        .iter()
+                        .any(|(u, _)| unknowns.binary_search(u).is_ok())
+                })
+                .collect();
+            let mut improved = false;
+            for i in candidates {
+                let Some(v) = values[i] else { continue };
+                // Away from where the map would put it unconstrained first.
+                let y = self.forms[i].value(x);
+                for delta in if y >= v as f64 { [1, -1] } else { [-1, 1] } {
+                    if trials >= UNCOLLAPSE_TRIALS || !tried.insert((i, v + delta)) {
+                        continue;
+                    }
+                    trials += 1;
+                    let mut trial = values.to_vec();
+                    trial[i] = Some(v + delta);
+                    let (solved, dependent) = self.solve(order, &trial, x, targets)?;
+                    if dependent.iter().any(|&j| {
+                        distance_to_integer(self.forms[j].value(&solved.x)) > NEAR_INTEGER
+                    }) {
+                        continue;
+                    }
+                    let after = self.badness(&solved.x, s);
+                    if after < badness {
+                        for j in dependent {
+                            trial[j] = Some(self.forms[j].value(&solved.x).round() as i64);
+                        }
+                        values.copy_from_slice(&trial);
+                        *x = solved.x.clone();
+                        *system = solved;
+                        flipped = self.flipped_faces(x, s);
+                        badness = after;
+                        kept += 1;
+                        improved = true;
+                        break;
+                    }
+                }
+                if improved {
+                    break;
+                }
+            }
+            if !improved {
+                break;
+            }
+        }
+        Ok(kept)
+    }
+
+    /// Whether face `f` of `x` (grid size `s`) is flipped or collapsed: its
+    /// UV area below [`COLLAPSED_SHARE`] of its area in the seamless map.
+    fn collapsed(&self, f: usize, x: &[f64], s: f64) -> bool {
+        !(signed_uv_area(unknown_uv(&self.elements[f], x)) * s * s
+            > COLLAPSED_SHARE * self.seamless_areas[f])
+    }
+
+    /// Faces flipped or collapsed ([`Self::collapsed`]), and the faces around
+    /// [`Self::wound_vertices`].
+    fn flipped_faces(&self, x: &[f64], s: f64) -> Vec<usize> {
+        let mut bad: Vec<usize> = (0..self.elements.len())
+            .filter(|&f| self.collapsed(f, x, s))
+            .collect();
+        let wound = self.wound_vertices(x);
+        if !wound.is_empty() {
+            bad.extend(
+                (0..self.faces.len())
+                    .filter(|&f| self.faces[f].iter().any(|v| wound.binary_search(v).is_ok())),
+            );
+            bad.sort_unstable();
+            bad.dedup();
+        }
+        bad
+    }
+
+    /// How far `x` is from a valid map: flipped or collapsed faces, plus
+    /// [`WOUND_WEIGHT`] per wound vertex (a move must not trade a few
+    /// collapsed slivers for a vertex the map winds around).
+    fn badness(&self, x: &[f64], s: f64) -> usize {
+        let collapsed = (0..self.elements.len())
+            .filter(|&f| self.collapsed(f, x, s))
+            .count();
+        collapsed + WOUND_WEIGHT * self.wound_vertices(x).len()
+    }
+
+    /// Vertices whose UV angle sum is off the seamless map's by more than pi
+    /// (ascending).
+    fn wound_vertices(&self, x: &[f64]) -> Vec<u32> {
+        let sums = corner_angle_sums(&self.faces, self.angle_sums.len(), |f| {
+            unknown_uv(&self.elements[f], x)
+        });
+        (0..sums.len() as u32)
+            .filter(|&v| (sums[v as usize] - self.angle_sums[v as usize]).abs() > PI)
+            .collect()
+    }
+
+    fn flipped(&self, x: &[f64]) -> usize {
+        self.elements
+            .iter()
+            .filter(|el| !(signed_uv_area(unknown_uv(el, x)) > 0.0))
+            .count()
+    }
+
+    /// Factors the KKT of the seam rows, the rounded forms `order` (their
+    /// values in `values`) and the gauge pins each component still needs
+    /// (held at `x`'s values), and solves for the map closest to `targets`.
+    /// Also returns the forms of `order` left out because the earlier rows
+    /// determine them.
+    fn solve(
+        &self,
+        order: &[usize],
+        values: &[Option<i64>],
+        x: &[f64],
+        targets: &[[[f64; 2]; 2]],
+    ) -> Result<(RoundedSystem, Vec<usize>), QuantizeError> {
+        let mut rows = self.seam_rows.clone();
+        let mut rhs_rows = vec![0.0; rows.len()];
+        let mut constrained = vec![Vec::<[i64; 2]>::new(); self.pins.len()];
+        for &i in order {
+            let form = &self.forms[i];
+            rows.push(form.row.clone());
+            rhs_rows.push(values[i].unwrap_or(0) as f64);
+            constrained[form.component].push(form.response);
+        }
+        // A component's translations the rounded forms do not fix are held by its pin.
+        for (c, pin) in self.pins.iter().enumerate() {
+            for (k, &unknown) in pin.iter().enumerate() {
+                let mut unit = [0i64; 2];
+                unit[k] = 1;
+                let mut with = constrained[c].clone();
+                with.push(unit);
+                if translation_rank(&with) > translation_rank(&constrained[c]) {
+                    constrained[c].push(unit);
+                    rows.push(vec![(unknown, 1)]);
+                    rhs_rows.push(x[unknown]);
+                }
+            }
+        }
+        let keep = independent_rows(&rows, self.n_unknowns);
+        let n_seam = self.seam_rows.len();
+        let dependent = order
+            .iter()
+            .zip(&keep[n_seam..])
+            .filter(|(_, &k)| !k)
+            .map(|(&i, _)| i)
+            .collect();
+        let mut c = Vec::new();
+        let mut b = Vec::new();
+        for ((row, k), v) in rows.iter().zip(keep).zip(rhs_rows) {
+            if k {
+                c.extend(row.iter().map(|&(i, a)| (b.len(), i, a as f64)));
+                b.push(v);
+            }
+        }
+        let kkt = Kkt::assemble(&self.stiffness, self.n_unknowns, &c, b.len())?;
+        let solver = factored(&kkt)?;
+        let mut system = RoundedSystem {
+            solver,
+            c,
+            b,
+            n: self.n_unknowns,
+            x: Vec::new(),
+        };
+        system.x = system.resolve(self, targets)?;
+        Ok((system, dependent))
+    }
+}
+
+/// A factored KKT of [`Quantizer::solve`] and its constraint values.
+struct RoundedSystem {
+    solver: LdltSolver,
+    c: Vec<Triplet>,
+    b: Vec<f64>,
+    n: usize,
+    x: Vec<f64>,
+}
+
+impl RoundedSystem {
+    /// `q <- Z (Zᵀ A Z)⁻¹ Zᵀ q` (the untangler's preconditioner): the KKT
+    /// solve for `(q, 0)`, put back onto `C q = 0` by `projector`; 0 when it fails.
+    fn precondition(&self, q: &mut [f64], projector: Option<&NullSpaceProjector>) {
+        let mut rhs = q.to_vec();
+        rhs.resize(self.n + self.b.len(), 0.0);
+        match self.solver.solve_many_to(&rhs, 1, 1e-8) {
+            Ok((x, _)) => q.copy_from_slice(&x[..self.n]),
+            Err(_) => q.iter_mut().for_each(|v| *v = 0.0),
+        }
+        if let Some(projector) = projector {
+            projector.project(q, 1e-14, 3);
+        }
+    }
+
+    /// `x` moved back onto the rows `C x = b` by the smallest change in the
+    /// stiffness norm (one solve for `(0, b - C x)`).
+    fn onto_constraints(&self, mut x: Vec<f64>) -> Result<Vec<f64>, QuantizeError> {
+        let mut rhs = vec![0.0; self.n];
+        let cx = constraint_values(&self.c, self.b.len(), &x);
+        rhs.extend(self.b.iter().zip(&cx).map(|(b, v)| b - v));
+        let dx = self.solver.solve_many_to(&rhs, 1, SOLVE_TOLERANCE)?.0;
+        x.iter_mut().zip(&dx).for_each(|(v, d)| *v += d);
+        Ok(x)
+    }
+
+    /// The map closest to per-face target Jacobians `targets` under this system's rows.
+    fn resolve(&self, q: &Quantizer, targets: &[[[f64; 2]; 2]]) -> Result<Vec<f64>, QuantizeError> {
+        let mut rhs = vec![0.0; q.n_unknowns];
+        for (el, t) in q.elements.iter().zip(targets) {
+            for k in 0..3 {
+                let g = el.g[k];
+                for c in 0..2 {
+                    rhs[el.x[c][k]] += el.area * (g[0] * t[c][0] + g[1] * t[c][1]);
+                }
+            }
+        }
+        rhs.extend_from_slice(&self.b);
+        let x = self.solver.solve_many_to(&rhs, 1, SOLVE_TOLERANCE)?.0;
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(QuantizeError::Param(ParamError::NotFinite {
+                what: "quantized map",
+            }));
+        }
+        Ok(x[..q.n_unknowns].to_vec())
+    }
+}
+
+/// Per form: the triples of distinct-enough single-unknown forms that hold
+/// the same coordinate of the three corners of some triangle.
+fn collapse_triples(
+    elements: &[Element],
+    forms: &[Form],
+    n_unknowns: usize,
+) -> Vec<Vec<[usize; 3]>> {
+    let mut form_of = vec![usize::MAX; n_unknowns];
+    for (i, f) in forms.iter().enumerate() {
+        if let (FormKind::Cone | FormKind::Point, [(u, 1)]) = (f.kind, f.row.as_slice()) {
+            form_of[*u] = i;
+        }
+    }
+    let mut triples = vec![Vec::new(); forms.len()];
+    for el in elements {
+        for c in 0..2 {
+            let t = el.x[c].map(|u| form_of[u]);
+            if t.contains(&usize::MAX) || (t[0] == t[1] && t[1] == t[2]) {
+                continue;
+            }
+            for &i in &t {
+                if !triples[i].contains(&t) {
+                    triples[i].push(t);
+                }
+            }
+        }
+    }
+    triples
+}
+
+/// Sum of the signed UV corner angles at every vertex, `uv_of(f)` the UV
+/// triangle of face `f`.
+fn corner_angle_sums(
+    faces: &[[u32; 3]],
+    n_vertices: usize,
+    uv_of: impl Fn(usize) -> [[f64; 2]; 3],
+) -> Vec<f64> {
+    let mut sums = vec![0.0; n_vertices];
+    for (f, face) in faces.iter().enumerate() {
+        let uv = uv_of(f);
+        for k in 0..3 {
+            let (p, a, b) = (uv[k], uv[(k + 1) % 3], uv[(k + 2) % 3]);
+            let (ea, eb) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
+            sums[face[k] as usize] +=
+                (ea[0] * eb[1] - ea[1] * eb[0]).atan2(ea[0] * eb[0] + ea[1] * eb[1]);
+        }
+    }
+    sums
+}
+
+/// `|y - round(y)|`.
+fn distance_to_integer(y: f64) -> f64 {
+    (y - y.round()).abs()
+}
+
+/// Rank (0, 1 or 2) of a set of integer 2-vectors.
+fn translation_rank(v: &[[i64; 2]]) -> usize {
+    let Some(first) = v.iter().find(|a| a[0] != 0 || a[1] != 0) else {
+        return 0;
+    };
+    if v.iter().any(|a| first[0] * a[1] - first[1] * a[0] != 0) {
+        2
+    } else {
+        1
+    }
+}
+
+/// Disk component (index of its pin in `cut.pins`) of every wedge.
+fn wedge_components(cut: &CutGraph) -> Vec<usize> {
+    let mut uf = UnionFind::new(cut.n_wedges);
+    for f in cut.wedge.chunks(3) {
+        uf.union(f[0], f[1]);
+        uf.union(f[0], f[2]);
+    }
+    let mut of_root = vec![usize::MAX; cut.n_wedges];
+    for (i, &p) in cut.pins.iter().enumerate() {
+        let r = uf.find(p) as usize;
+        of_root[r] = i;
+    }
+    (0..cut.n_wedges as u32)
+        .map(|w| of_root[uf.find(w) as usize])
+        .collect()
+}
+
+/// The integer forms: both coordinates of one wedge of every singular point
+/// (a cut-mesh vertex whose UV angle is off straight by more than pi/4), the
+/// constant of every isoline class, and both components of every seam
+/// curve's translation. Duplicates (the same row) are listed once.
+///
+/// One wedge per point: its other wedges follow from it through seam
+/// translations with unit coefficients, whereas two wedges of points
+/// rounded first can determine a third point with coefficient 1/2 (a
+/// half-turn seam between cones: `f_g(b) + f_f(b) = 2 p_a`).
+fn integer_forms(
+    mesh: &TriMesh,
+    placement: &ConePlacement,
+    isoline: &[u8],
+    cut: &CutGraph,
+    vars: &[Vec<usize>; 2],
+    component: &[usize],
+    uv: &[[f64; 2]],
+) -> Vec<Form> {
+    let cm = &placement.cut.mesh;
+    let sums = corner_angle_sums(cm.faces(), cm.n_vertices(), |f| {
+        [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]
+    });
+    let mut set = RowSet::default();
+    let mut forms = Vec::new();
+    let mut push = |mut row: Vec<(usize, i64)>,
+                    kind: FormKind,
+                    component: usize,
+                    response: [i64; 2],
+                    forms: &mut Vec<Form>| {
+        if set.push(&mut row) {
+            forms.push(Form {
+                row: set.rows[set.rows.len() - 1].clone(),
+                kind,
+                component,
+                response,
+            });
+        }
+    };
+    let mut represented = vec![false; cm.n_vertices()];
+    for (f, face) in cm.faces().iter().enumerate() {
+        for k in 0..3 {
+            let cv = face[k] as usize;
+            let straight = if cm.is_boundary_vertex(face[k]) {
+                PI
+            } else {
+                2.0 * PI
+            };
+            if (sums[cv] - straight).abs() > FRAC_PI_4
+                && !std::mem::replace(&mut represented[cv], true)
+            {
+                let w = cut.wedge[3 * f + k] as usize;
+                let kind = if cm.is_boundary_vertex(face[k]) {
+                    FormKind::Point
+                } else {
+                    FormKind::Cone
+                };
+                for (c, unit) in [(0, [1, 0]), (1, [0, 1])] {
+                    push(vec![(vars[c][w], 1)], kind, component[w], unit, &mut forms);
+                }
+            }
+        }
+    }
+    for h in 0..3 * mesh.n_faces() {
+        let c = isoline[h] as usize;
+        if c < 2 {
+            let w = cut.wedge[h] as usize;
+            let mut unit = [0, 0];
+            unit[c] = 1;
+            push(
+                vec![(vars[c][w], 1)],
+                FormKind::Point,
+                component[w],
+                unit,
+                &mut forms,
+            );
+        }
+    }
+    for curve in &cut.curves {
+        let r = curve_rotation(curve.matching);
+        let (fa, ga) = curve_wedge_pairs(mesh, cut, curve)[0];
+        for c in 0..2 {
+            // t_c = f_g(a)_c - sum_d r[c][d] f_f(a)_d; a translation d of the disk moves it by ((I - r) d)_c.
+            let mut row: Vec<(usize, i64)> = vec![(vars[c][ga as usize], 1)];
+            row.extend(
+                (0..2)
+                    .filter(|&d| r[c][d] != 0)
+                    .map(|d| (vars[d][fa as usize], -r[c][d])),
+            );
+            let response = [i64::from(c == 0) - r[c][0], i64::from(c == 1) - r[c][1]];
+            push(
+                row,
+                FormKind::Translation,
+                component[fa as usize],
+                response,
+                &mut forms,
+            );
+        }
+    }
+    forms
+}
+
+/// UV triangle of element `el` for the unknown vector `x`.
+fn unknown_uv(el: &Element, x: &[f64]) -> [[f64; 2]; 3] {
+    [0, 1, 2].map(|k| [x[el.x[0][k]], x[el.x[1][k]]])
+}

@@ -1,0 +1,164 @@
+//! Quad extraction from an integer-grid map, after QEx (Ebke, Bommes,
+//! Chaine, Kobbelt 2013, "QEx: Robust Quad Mesh Extraction"):
+//!
+//! 1. `snap::snap`: the corner UVs become an exact fixed-point integer-grid
+//!    map (exact transitions, exactly consistent corners);
+//! 2. `vertices::QuadVertices`: the integer points (inside faces, inside
+//!    edges, at mesh vertices) with their outgoing isoline directions;
+//! 3. `trace::trace_edge`: each direction's unit isoline segment followed
+//!    exactly to the next integer point;
+//! 4. `faces::build_quads`: the cycles of traced half-edges are the quads.
+//!
+//! Every predicate after step 1 is exact integer arithmetic. Where the map is
+//! not a valid integer-grid map the extractor skips what it cannot close and
+//! records a [`QuadDefect`].
+
+mod faces;
+mod snap;
+mod trace;
+mod vertices;
+
+#[cfg(test)]
+#[path = "extract_tests.rs"]
+mod extract_tests;
+
+use super::{QuadDefect, QuadMesh, SurfacePoint};
+use crate::mesh::NONE;
+use crate::TriMesh;
+use snap::{dot, orient, sub};
+use vertices::{Place, QuadVertices};
+
+/// Largest accepted UV coordinate magnitude (grid units); keeps the exact
+/// fixed-point predicates within `i128`.
+pub const MAX_UV: f64 = (1u64 << 28) as f64;
+
+/// Knobs of [`extract_quads`].
+#[derive(Clone, Copy, Debug)]
+pub struct ExtractOptions {
+    /// UV coordinates within this distance of an integer are snapped to it;
+    /// a transition whose translation is further than this from an integer
+    /// vector is reported as a defect.
+    pub snap_tolerance: f64,
+    /// A trace crossing more triangles than this is abandoned (a defect).
+    pub max_trace_steps: usize,
+    /// At most this many quad vertices are enumerated (a defect beyond).
+    pub max_vertices: usize,
+}
+
+impl Default for ExtractOptions {
+    fn default() -> Self {
+        ExtractOptions { snap_tolerance: 1e-6, max_trace_steps: 1_000, max_vertices: 10_000_000 }
+    }
+}
+
+/// Input that [`extract_quads`] cannot work with at all.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExtractError {
+    /// `uv` does not have one entry per face corner.
+    CornerCount { expected: usize, found: usize },
+    /// A UV is NaN or infinite.
+    NotFinite { corner: usize },
+    /// A UV coordinate exceeds [`MAX_UV`] in magnitude.
+    OutOfRange { corner: usize },
+}
+
+impl std::fmt::Display for ExtractError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ExtractError::CornerCount { expected, found } => {
+                write!(f, "expected {expected} corner UVs (3 per face), found {found}")
+            }
+            ExtractError::NotFinite { corner } => write!(f, "UV of corner {corner} is not finite"),
+            ExtractError::OutOfRange { corner } => write!(f, "UV of corner {corner} exceeds {MAX_UV} grid units"),
+        }
+    }
+}
+
+impl std::error::Error for ExtractError {}
+
+/// Extracts the quad mesh of the integer-grid map `uv` (one UV per face
+/// corner `3 f + k`, grid units) on `mesh`.
+///
+/// Vertices are the integer points of the map, each exactly on the input
+/// surface (barycentric in its face); quads are the unit grid cells,
+/// counter-clockwise like the input, with their corner UVs in the chart of
+/// one face. On a valid map the result is a pure, manifold quad mesh with
+/// the input's Euler characteristic and boundary loops, valence 4 except
+/// `4 − k` at a cone of index `k`, and every input edge on an integer isoline
+/// covered by quad edges. Where the map is invalid (flips, non-integer
+/// transitions or cones) the affected cells are skipped and listed in
+/// [`QuadMesh::defects`]. Errs only on a wrong number of UVs or a UV that is
+/// not finite or beyond [`MAX_UV`]; never panics.
+pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) -> Result<QuadMesh, ExtractError> {
+    let expected = 3 * mesh.n_faces();
+    if uv.len() != expected {
+        return Err(ExtractError::CornerCount { expected, found: uv.len() });
+    }
+    for (corner, p) in uv.iter().enumerate() {
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            return Err(ExtractError::NotFinite { corner });
+        }
+        if p[0].abs() > MAX_UV || p[1].abs() > MAX_UV {
+            return Err(ExtractError::OutOfRange { corner });
+        }
+    }
+    let mut defects: Vec<QuadDefect> = Vec::new();
+    let map = snap::snap(mesh, uv, options.snap_tolerance, &mut defects);
+    let qv = QuadVertices::enumerate(mesh, &map, options.max_vertices, &mut defects);
+    let target: Vec<u32> = (0..qv.slots.len() as u32)
+        .map(|s| match trace::trace_edge(mesh, &map, &qv, s, options.max_trace_steps) {
+            Ok(t) => t,
+            Err(failure) => {
+                defects.push(QuadDefect { face: failure.face, what: failure.what.into() });
+                NONE
+            }
+        })
+        .collect();
+    let cells = faces::build_quads(mesh, &map, &qv, &target, &mut defects);
+
+    let mut positions = Vec::with_capacity(qv.list.len());
+    let mut locations = Vec::with_capacity(qv.list.len());
+    for q in &qv.list {
+        let loc = surface_point(mesh, &map, q.place, q.uv);
+        let corners = mesh.faces()[loc.face as usize];
+        let mut x = [0.0; 3];
+        for (k, &c) in corners.iter().enumerate() {
+            let p = mesh.position(c);
+            for i in 0..3 {
+                x[i] += loc.bary[k] * p[i];
+            }
+        }
+        positions.push(x);
+        locations.push(loc);
+    }
+    Ok(QuadMesh { positions, locations, quads: cells.quads, uv: cells.uv, defects })
+}
+
+/// The input face and barycentric coordinates of the integer point `uv`
+/// (home chart of `place`, see [`vertices::QuadVertex`]).
+fn surface_point(mesh: &TriMesh, map: &snap::SnappedMap, place: Place, uv: snap::Point) -> SurfacePoint {
+    match place {
+        Place::Face(f) => {
+            let x = map.corners(f);
+            let area = orient(x[0], x[1], x[2]) as f64;
+            let bary = [0, 1, 2].map(|k| orient(x[(k + 1) % 3], x[(k + 2) % 3], uv) as f64 / area);
+            SurfacePoint { face: f, bary }
+        }
+        Place::Edge(e) => {
+            let h0 = mesh.edge_halfedges(e)[0];
+            let (a, b) = (map.uv[h0 as usize], map.uv[mesh.next(h0) as usize]);
+            let w = sub(b, a);
+            let t = dot(sub(uv, a), w) as f64 / dot(w, w) as f64;
+            let mut bary = [0.0; 3];
+            bary[(h0 % 3) as usize] = 1.0 - t;
+            bary[((h0 + 1) % 3) as usize] = t;
+            SurfacePoint { face: h0 / 3, bary }
+        }
+        Place::Vertex(v) => {
+            let h0 = mesh.vertex_halfedge(v);
+            let mut bary = [0.0; 3];
+            bary[(h0 % 3) as usize] = 1.0;
+            SurfacePoint { face: h0 / 3, bary }
+        }
+    }
+}

@@ -1,0 +1,67 @@
+//! Quad meshes from integer-grid maps (paper Figures 1 and 12; the
+//! extraction follows QEx, Ebke et al. 2013): the integer points of the map
+//! become the quad vertices, the integer isolines between them the quad
+//! edges, and the grid cells the quads ([`extract`]). [`check`] measures
+//! the result (topology, valences, corner angles, flips, distance to the
+//! input surface).
+//!
+//! Input: a [`TriMesh`](crate::TriMesh) and one UV per face corner
+//! (`3 f + k`) in grid units that form an integer-grid map: across every
+//! interior edge the two sides' UVs differ by a rotation of `k·90°` plus an
+//! integer translation, every cone lies on an integer point, and every
+//! boundary edge on an integer isoline.
+
+pub mod check;
+pub mod extract;
+
+pub use check::{check_quads, CheckOptions, QuadReport};
+pub use extract::{extract_quads, ExtractError, ExtractOptions};
+
+use serde::Serialize;
+
+/// A quad mesh traced on a triangle mesh.
+#[derive(Clone, Debug, Default)]
+pub struct QuadMesh {
+    /// Vertex positions, each exactly on the input surface.
+    pub positions: Vec<[f64; 3]>,
+    /// Where each vertex lies on the input: its face and barycentric coordinates.
+    pub locations: Vec<SurfacePoint>,
+    /// Quads, counter-clockwise seen from the input surface's outside (the
+    /// input's face orientation).
+    pub quads: Vec<[u32; 4]>,
+    /// Grid coordinates of each quad corner (`4 q + i`), in the chart of the
+    /// input face the quad was traced in: the corners of a quad are an
+    /// integer unit square up to a `k·90°` rotation and translation.
+    pub uv: Vec<[f64; 2]>,
+    /// Where the extractor had to repair the map (empty when it is a valid
+    /// integer-grid map).
+    pub defects: Vec<QuadDefect>,
+}
+
+/// A point of the input surface: face `face` and barycentric coordinates
+/// with respect to its corners.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SurfacePoint {
+    pub face: u32,
+    pub bary: [f64; 3],
+}
+
+/// A place where the map is not a valid integer-grid map and what the
+/// extractor did there.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct QuadDefect {
+    /// Input face where it was found.
+    pub face: u32,
+    /// What went wrong and what was done, in a sentence.
+    pub what: String,
+}
+
+impl QuadMesh {
+    pub fn n_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn n_quads(&self) -> usize {
+        self.quads.len()
+    }
+}

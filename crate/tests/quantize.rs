@@ -1,0 +1,200 @@
+//! Integer-grid maps (param::quantize) on the shared meshes, checked from the
+//! output UVs alone: across every interior edge the two sides differ by a
+//! k·90° rotation plus an integer translation (grid units), every cone and
+//! singular corner is an integer point, every feature and boundary edge lies
+//! on an integer isoline, and no triangle is flipped.
+
+use conemap::features::FeatureSet;
+use conemap::mesh::TriMesh;
+use conemap::param::quantize::GridSize;
+use conemap::pipeline::{solve, SolveOptions};
+use std::f64::consts::PI;
+
+mod common;
+use common::shared_mesh as load;
+
+/// Largest distance from an integer among `values`.
+fn off_integer(values: impl IntoIterator<Item = f64>) -> f64 {
+    values.into_iter().fold(0.0f64, |m, v| m.max((v - v.round()).abs()))
+}
+
+/// Checks the integer-grid properties of per-corner `uv` on `mesh` with
+/// `features` (seams, isolines); returns the numbers of flipped triangles
+/// and of singular vertices (UV angle sum off 2 pi, away from flips) off
+/// an integer point.
+fn check_integer_grid(name: &str, mesh: &TriMesh, features: &FeatureSet, uv: &[[f64; 2]]) -> (usize, usize) {
+    let rotate = |k: usize, p: [f64; 2]| match k % 4 {
+        0 => p,
+        1 => [-p[1], p[0]],
+        2 => [-p[0], -p[1]],
+        _ => [p[1], -p[0]],
+    };
+    let mut worst_translation = 0.0f64;
+    let mut worst_rotation = 0.0f64;
+    for e in 0..mesh.n_edges() as u32 {
+        if mesh.is_boundary_edge(e) {
+            continue;
+        }
+        let [h, t] = mesh.edge_halfedges(e);
+        // Side f: h from a to b; side g: t from b to a.
+        let (fa, fb) = (uv[h as usize], uv[mesh.next(h) as usize]);
+        let (gb, ga) = (uv[t as usize], uv[mesh.next(t) as usize]);
+        let df = [fb[0] - fa[0], fb[1] - fa[1]];
+        let dg = [gb[0] - ga[0], gb[1] - ga[1]];
+        let k = (0..4)
+            .min_by(|&i, &j| {
+                let d = |k: usize| {
+                    let r = rotate(k, df);
+                    (r[0] - dg[0]).hypot(r[1] - dg[1])
+                };
+                d(i).total_cmp(&d(j))
+            })
+            .unwrap();
+        let r = rotate(k, df);
+        worst_rotation = worst_rotation.max((r[0] - dg[0]).hypot(r[1] - dg[1]));
+        let ra = rotate(k, fa);
+        worst_translation = worst_translation.max(off_integer([ga[0] - ra[0], ga[1] - ra[1]]));
+    }
+    assert!(worst_rotation < 1e-6, "{name}: seam not a k·90° rotation ({worst_rotation:.2e})");
+    assert!(worst_translation < 1e-6, "{name}: seam translation off an integer by {worst_translation:.2e}");
+
+    // Singular vertices (UV angle sum off 2 pi inside, or off pi on the boundary) at integer points.
+    let mut sums = vec![0.0; mesh.n_vertices()];
+    for (f, face) in mesh.faces().iter().enumerate() {
+        for k in 0..3 {
+            let (p, a, b) = (uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
+            let (ea, eb) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
+            sums[face[k] as usize] += (ea[0] * eb[1] - ea[1] * eb[0]).atan2(ea[0] * eb[0] + ea[1] * eb[1]);
+        }
+    }
+    let flipped: Vec<usize> = (0..mesh.n_faces())
+        .filter(|&f| {
+            let [p, q, r] = [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]];
+            ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        })
+        .collect();
+    // (A flipped triangle's corners have no meaningful angle sum.)
+    let near_flip = |v: u32| mesh.vertex_faces(v).any(|f| flipped.contains(&(f as usize)));
+    let (mut cones, mut off_grid) = (0, 0);
+    for (v, &sum) in sums.iter().enumerate() {
+        if mesh.is_boundary_vertex(v as u32) || near_flip(v as u32) {
+            continue;
+        }
+        if (sum - 2.0 * PI).abs() > 0.25 * PI {
+            cones += 1;
+            for f in mesh.vertex_faces(v as u32) {
+                let k = mesh.faces()[f as usize].iter().position(|&w| w as usize == v).unwrap();
+                let p = uv[3 * f as usize + k];
+                if off_integer(p) > 1e-9 {
+                    println!("{name}: singular vertex v{v} (angle {sum}) at {p:?}, not an integer point");
+                    off_grid += 1;
+                    break;
+                }
+            }
+        }
+    }
+    assert!(cones > 0, "{name}: no cone found");
+
+    // Features and boundary on integer isolines.
+    let mut worst_isoline = 0.0f64;
+    for e in 0..mesh.n_edges() as u32 {
+        if !(features.contains(e) || mesh.is_boundary_edge(e)) {
+            continue;
+        }
+        for h in mesh.edge_halfedges(e) {
+            if mesh.is_boundary_halfedge(h) {
+                continue;
+            }
+            let (a, b) = (uv[h as usize], uv[mesh.next(h) as usize]);
+            let c = if (a[0] - b[0]).abs() < (a[1] - b[1]).abs() { 0 } else { 1 };
+            worst_isoline = worst_isoline.max(off_integer([a[c], b[c]]));
+        }
+    }
+    assert!(worst_isoline < 1e-9, "{name}: feature edge off an integer isoline by {worst_isoline:.2e}");
+    (flipped.len(), off_grid)
+}
+
+/// Quantizes `name` and checks the integer-grid properties; returns the
+/// flipped triangles and off-grid singular vertices (asserted 0 by the
+/// callers that meet it).
+fn run(name: &str, sharp: Option<f64>, quads: usize) -> (usize, usize) {
+    let input = load(name);
+    let features = match sharp {
+        Some(deg) => FeatureSet::sharp_edges(&input, deg),
+        None => FeatureSet::none(&input),
+    };
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let quantizer = solution.quantizer().unwrap_or_else(|e| panic!("{name}: {e}"));
+    let map = quantizer.quantize(&solution.mesh, GridSize::Quads(quads), &mut |_, _| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let r = &map.report;
+    println!("{name} {quads}: {r:?}");
+    assert_eq!(r.conflicts, 0, "{name}: integers not met");
+    assert!((r.cells / quads as f64 - 1.0).abs() < 0.1, "{name}: {} cells for {quads} asked", r.cells);
+    assert!(r.distortion_after >= r.distortion_before * 0.99 && r.distortion_after < 1.5 * r.distortion_before, "{name}: distortion {r:?}");
+    let (flipped, off_grid) = check_integer_grid(name, &solution.mesh, &solution.features, &map.uv);
+    assert_eq!(flipped, r.flipped, "{name}: flip count");
+    (flipped, off_grid)
+}
+
+#[test]
+fn spot_3000_quads() {
+    assert_eq!(run("spot.obj", None, 3000), (0, 0));
+}
+
+/// Known shortfall (docs/STATUS.md): two triangles between nearby feature
+/// isolines collapse onto one grid line at 3 000 quads, and a vertex near
+/// them winds; integers, seams and isolines hold.
+#[test]
+fn fandisk_sharp_60_3000_quads() {
+    let (flipped, off_grid) = run("fandisk.obj", Some(60.0), 3000);
+    assert!(flipped <= 2 && off_grid <= 1, "{flipped} flipped, {off_grid} off the grid");
+}
+
+#[test]
+fn bunny_1000_quads() {
+    assert_eq!(run("bff-bunny.obj", None, 1000), (0, 0));
+}
+
+/// The quad mesh of spot's integer-grid map: closed, Euler characteristic
+/// 2, pure valid quads, singular vertices exactly the cones with valence
+/// `4 - k`, on the surface.
+#[test]
+fn spot_quad_mesh() {
+    use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
+    let input = load("spot.obj");
+    let features = FeatureSet::none(&input);
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
+    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
+    assert!(quads.defects.is_empty(), "{:?}", &quads.defects[..quads.defects.len().min(5)]);
+    let r = check_quads(&solution.mesh, &quads, &CheckOptions::default());
+    assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (2, 0, 1));
+    assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.degenerate_quads, r.flipped_quads), (0, 0, 0, 0));
+    assert!((r.quads as f64 - map.report.cells).abs() < 1.0, "{} quads, {} cells", r.quads, map.report.cells);
+    // Singular vertices = cones, valence 4 - k.
+    let mut expected: std::collections::BTreeMap<u32, usize> = std::collections::BTreeMap::new();
+    for c in &solution.placement.cones {
+        *expected.entry((4 - c.k) as u32).or_default() += 1;
+    }
+    let found: std::collections::BTreeMap<u32, usize> = r.valence_histogram.interior.iter().filter(|(&v, _)| v != 4).map(|(&v, &n)| (v, n)).collect();
+    assert_eq!(found, expected);
+    assert!(r.distance_quads_to_input_relative.unwrap() < 0.01 && r.distance_input_to_quads_relative.unwrap() < 0.01, "{r:?}");
+    assert!(r.angle_mean_deviation < 7.1, "mean corner-angle deviation {}", r.angle_mean_deviation);
+}
+
+/// The same quantizer serves a second grid size (the page re-runs only this
+/// stage when the quad count changes).
+#[test]
+fn quantizer_reruns_for_another_size() {
+    let input = load("spot.obj");
+    let features = FeatureSet::none(&input);
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let quantizer = solution.quantizer().unwrap();
+    for n in [2000, 10000] {
+        let map = quantizer.quantize(&solution.mesh, GridSize::Quads(n), &mut |_, _| {}).unwrap();
+        assert_eq!(map.report.conflicts, 0);
+        assert_eq!(check_integer_grid("spot.obj", &solution.mesh, &features, &map.uv), (0, 0));
+    }
+    assert!(quantizer.quantize(&solution.mesh, GridSize::Length(-1.0), &mut |_, _| {}).is_err());
+}
+
