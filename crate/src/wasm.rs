@@ -297,13 +297,8 @@ impl MeshSession {
         let corners: Vec<u32> = quad_mesh.quads.iter().flatten().copied().collect();
         let edges: Vec<u32> = quads::check::quad_edges(&quad_mesh).iter().flat_map(|e| e.vertices).collect();
         let singular: Vec<u32> = report.singular_vertices.iter().filter(|v| !v.boundary).flat_map(|v| [v.vertex, v.valence]).collect();
-        let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
-        let mut grid_input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &map.uv)
-            .map_err(|e| JsError::new(&e.to_string()))?;
-        if let (Some(source), 0) = (&self.source, sol.splits) {
-            grid_input = grid_input.with_gltf_source(source, &self.files[0], &self.files[1..]);
-        }
-        let grid_glb = export::write_glb(&grid_input, &ExportOptions { grid_units: true, checker_cell: Some(1.0), ..ExportOptions::default() });
+        let grid_options = ExportOptions { grid_units: true, checker_cell: Some(1.0), ..ExportOptions::default() };
+        let grid_glb = self.export_solved(sol, &map.uv, |input| export::write_glb(input, &grid_options))?;
         let obj = export::quads::write_quad_obj(&quad_mesh, &format!("{} quads, grid cell {}", quad_mesh.n_quads(), map.report.grid_size));
         Ok(to_js(&QuadsResult {
             quantization: &map.report,
@@ -335,20 +330,32 @@ fn param_stage(p: &ParamProgress) -> (&'static str, usize, usize) {
 
 impl MeshSession {
     /// The result of `solve` for the solution `sol` of `mesh` (see [`SolveResult`]).
+    /// `write` applied to the export input of the solved mesh with per-corner
+    /// `uv`: the input's own attributes when the solve split nothing, else
+    /// the refined mesh (exactly, with its split edges).
+    fn export_solved<R>(&self, sol: &Solution, uv: &[[f64; 2]], write: impl FnOnce(&ExportInput) -> R) -> Result<R, JsError> {
+        let solved_raw;
+        let raw = if sol.splits > 0 {
+            solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
+            &solved_raw
+        } else {
+            &self.raw
+        };
+        let mut input = ExportInput::new(raw, &sol.mesh, uv).map_err(|e| JsError::new(&e.to_string()))?;
+        if let (Some(source), 0) = (&self.source, sol.splits) {
+            input = input.with_gltf_source(source, &self.files[0], &self.files[1..]);
+        }
+        Ok(write(&input))
+    }
+
     fn solution_object(&self, mesh: &TriMesh, features: &FeatureSet, sol: &Solution) -> Result<JsValue, JsError> {
         let corner_uv = sol.input_corner_uv(mesh);
         let uv: Vec<f32> = corner_uv.iter().flat_map(|p| p.map(|c| c as f32)).collect();
         let per_face: Vec<f32> =
             param::metrics::face_distortion(mesh, &corner_uv, sol.param.metrics.scale).iter().map(|&d| d as f32).collect();
-        // Exports of the solved mesh (with any split edges), exactly.
-        let solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
-        let mut input = ExportInput::new(if sol.splits > 0 { &solved_raw } else { &self.raw }, &sol.mesh, &sol.param.uv)
-            .map_err(|e| JsError::new(&e.to_string()))?;
-        if let (Some(source), 0) = (&self.source, sol.splits) {
-            input = input.with_gltf_source(source, &self.files[0], &self.files[1..]);
-        }
-        let glb = export::write_glb(&input, &ExportOptions::default());
-        let obj = export::write_obj(&input, &ExportOptions::default());
+        let (glb, obj) = self.export_solved(sol, &sol.param.uv, |input| {
+            (export::write_glb(input, &ExportOptions::default()), export::write_obj(input, &ExportOptions::default()))
+        })?;
         to_js(&SolveResult {
             cones: ConeResult::new(&sol.placement, sol.features.len(), sol.splits),
             uv: Float32Array::from(&uv[..]),

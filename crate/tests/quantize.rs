@@ -6,7 +6,7 @@
 
 use conemap::features::FeatureSet;
 use conemap::mesh::TriMesh;
-use conemap::param::quantize::GridSize;
+use conemap::param::{metrics::uv_angle_sums, quantize::GridSize};
 use conemap::pipeline::{solve, SolveOptions};
 use std::f64::consts::PI;
 
@@ -58,15 +58,8 @@ fn check_integer_grid(name: &str, mesh: &TriMesh, features: &FeatureSet, uv: &[[
     assert!(worst_rotation < 1e-6, "{name}: seam not a k·90° rotation ({worst_rotation:.2e})");
     assert!(worst_translation < 1e-6, "{name}: seam translation off an integer by {worst_translation:.2e}");
 
-    // Singular vertices (UV angle sum off 2 pi inside, or off pi on the boundary) at integer points.
-    let mut sums = vec![0.0; mesh.n_vertices()];
-    for (f, face) in mesh.faces().iter().enumerate() {
-        for k in 0..3 {
-            let (p, a, b) = (uv[3 * f + k], uv[3 * f + (k + 1) % 3], uv[3 * f + (k + 2) % 3]);
-            let (ea, eb) = ([a[0] - p[0], a[1] - p[1]], [b[0] - p[0], b[1] - p[1]]);
-            sums[face[k] as usize] += (ea[0] * eb[1] - ea[1] * eb[0]).atan2(ea[0] * eb[0] + ea[1] * eb[1]);
-        }
-    }
+    // Singular vertices (UV angle sum off 2 pi inside) at integer points.
+    let sums = uv_angle_sums(mesh, uv);
     let flipped: Vec<usize> = (0..mesh.n_faces())
         .filter(|&f| {
             let [p, q, r] = [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]];

@@ -96,9 +96,14 @@ impl Element {
         Element { w, x, g: hat_gradients(q, area), area }
     }
 
+    /// The UV triangle of the unknown vector `x`.
+    pub(super) fn unknowns_uv(&self, x: &[f64]) -> [[f64; 2]; 3] {
+        [0, 1, 2].map(|k| [x[self.x[0][k]], x[self.x[1][k]]])
+    }
+
     /// Jacobian for the unknown vector `x`.
     pub(super) fn jacobian(&self, x: &[f64]) -> [[f64; 2]; 2] {
-        jacobian(&self.g, [0, 1, 2].map(|k| [x[self.x[0][k]], x[self.x[1][k]]]))
+        jacobian(&self.g, self.unknowns_uv(x))
     }
 
     /// Jacobian for UV per wedge.

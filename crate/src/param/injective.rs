@@ -322,8 +322,8 @@ impl<'a> Refiner<'a> {
             // Line search: largest flip-free step, halved until E decreases.
             let mut t = 1.0f64;
             for el in self.elements {
-                let p = [0, 1, 2].map(|k| [x[el.x[0][k]], x[el.x[1][k]]]);
-                let q = [0, 1, 2].map(|k| [d[el.x[0][k]], d[el.x[1][k]]]);
+                let p = el.unknowns_uv(x);
+                let q = el.unknowns_uv(&d);
                 t = t.min(0.8 * max_step(p, q));
             }
             let mut accepted = None;
@@ -450,7 +450,7 @@ mod tests {
         elements
             .iter()
             .map(|el| {
-                let p = [0, 1, 2].map(|k| [x[el.x[0][k]], x[el.x[1][k]]]);
+                let p = el.unknowns_uv(x);
                 (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])
             })
             .fold(f64::INFINITY, f64::min)

@@ -16,14 +16,20 @@
 //! translations: a translation across a seam that ends at a cone `p` is
 //! `(I - r) p`, and the two sides of a half-turn seam from a corner `P` to a
 //! cone `p` satisfy `f_g(P) + f_f(P) = 2 p`, so rounding the cone later could
-//! leave it half-way between
-//! grid points. Last, ARAP local/global iterations (eq. 4) under all the
-//! integer rows pull the distortion back down, keeping every step that
-//! leaves no more flipped triangles than the rounding did.
+//! leave it half-way between grid points. A triangle whose three corners
+//! are rounded forms of one coordinate is never put onto one grid line.
+//!
+//! Then [`Quantizer::polish`]: the untangler under all the integer rows
+//! where the map folds, and ARAP local/global iterations (eq. 4), each kept
+//! unless it makes the map worse by [`Quantizer::badness`] (flipped or
+//! collapsed triangles, wound vertices). Where the map is still bad,
+//! [`Quantizer::uncollapse`] moves the integers at the bad triangles by one
+//! and the moved map is polished too; the better of the two is returned.
 //!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
-//! batch (the rows change), about `2 log2(forms)` of them, then one solve
-//! per ARAP iteration with the last factorization.
+//! batch (the rows change; about ten batches), one per `uncollapse` trial
+//! (at most [`UNCOLLAPSE_TRIALS`], only where the map is bad), and one
+//! solve per ARAP iteration with the last factorization.
 
 use super::cut_graph::{cut_graph, CutGraph};
 use super::element::{signed_uv_area, Element};
@@ -268,15 +274,11 @@ impl Quantizer {
             .map(|&p| [vars[0][p as usize], vars[1][p as usize]])
             .collect();
         let triples = collapse_triples(&elements, &forms, n_unknowns);
-        let map_area = (0..nf)
-            .map(|f| {
-                signed_uv_area([param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]).max(0.0)
-            })
-            .sum();
         let faces = mesh.faces().to_vec();
-        let seamless_areas = (0..nf)
+        let seamless_areas: Vec<f64> = (0..nf)
             .map(|f| signed_uv_area([param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]))
             .collect();
+        let map_area = seamless_areas.iter().map(|a| a.max(0.0)).sum();
         let angle_sums = corner_angle_sums(&faces, mesh.n_vertices(), |f| {
             [param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]
         });
@@ -346,9 +348,8 @@ impl Quantizer {
                 let take = ((free.len() as f64 * BATCH_FRACTION).ceil() as usize)
                     .max(near)
                     .min(free.len());
-                let batch: Vec<usize> = free[..take].iter().map(|f| f.1).collect();
+                let mut batch: Vec<usize> = free[..take].iter().map(|f| f.1).collect();
                 let before = order.len();
-                let mut batch = batch;
                 let mut retries = 0;
                 let (solved, dependent) = loop {
                     for &i in &batch {
@@ -398,15 +399,13 @@ impl Quantizer {
         // keeping whichever ends better.
         let mut moved_integers = 0;
         let (mut arap_iterations, mut untangled) = (0, false);
-        if let Some(solved) = system.as_mut() {
+        if let Some(mut moved_system) = system {
             let (polished, bad, iterations, untangle_ok) =
-                self.polish(x.clone(), solved, &targets, s)?;
-            (x, arap_iterations, untangled) = (polished, iterations, untangle_ok);
+                self.polish(x.clone(), &moved_system, &targets, s)?;
+            let rounded = std::mem::replace(&mut x, polished);
+            (arap_iterations, untangled) = (iterations, untangle_ok);
             if bad > 0 && UNCOLLAPSE_TRIALS > 0 {
-                let (mut moved_values, mut moved_x) = (values.clone(), x.clone());
-                let (start, _) = self.solve(&order, &values, &x, &targets)?;
-                moved_x.copy_from_slice(&start.x);
-                let mut moved_system = start;
+                let (mut moved_values, mut moved_x) = (values.clone(), rounded);
                 let moves = self.uncollapse(
                     &order,
                     &mut moved_values,
@@ -655,7 +654,7 @@ impl Quantizer {
     /// Whether face `f` of `x` (grid size `s`) is flipped or collapsed: its
     /// UV area below [`COLLAPSED_SHARE`] of its area in the seamless map.
     fn collapsed(&self, f: usize, x: &[f64], s: f64) -> bool {
-        !(signed_uv_area(unknown_uv(&self.elements[f], x)) * s * s
+        !(signed_uv_area(self.elements[f].unknowns_uv(x)) * s * s
             > COLLAPSED_SHARE * self.seamless_areas[f])
     }
 
@@ -691,7 +690,7 @@ impl Quantizer {
     /// (ascending).
     fn wound_vertices(&self, x: &[f64]) -> Vec<u32> {
         let sums = corner_angle_sums(&self.faces, self.angle_sums.len(), |f| {
-            unknown_uv(&self.elements[f], x)
+            self.elements[f].unknowns_uv(x)
         });
         (0..sums.len() as u32)
             .filter(|&v| (sums[v as usize] - self.angle_sums[v as usize]).abs() > PI)
@@ -701,7 +700,7 @@ impl Quantizer {
     fn flipped(&self, x: &[f64]) -> usize {
         self.elements
             .iter()
-            .filter(|el| !(signed_uv_area(unknown_uv(el, x)) > 0.0))
+            .filter(|el| !(signed_uv_area(el.unknowns_uv(x)) > 0.0))
             .count()
     }
 
@@ -857,8 +856,11 @@ fn collapse_triples(
     triples
 }
 
-/// Sum of the signed UV corner angles at every vertex, `uv_of(f)` the UV
-/// triangle of face `f`.
+/// Sum of the signed UV corner angles (`atan2`, so each corner of a flipped
+/// triangle counts negative) at every vertex, `uv_of(f)` the UV triangle of
+/// face `f`. Not `element::angle_sums(.., true)`: on a collapsed triangle
+/// that one takes the straight corner as +pi where `atan2` can give -pi
+/// (the sign of a zero cross product), and the wound-vertex counts differ.
 fn corner_angle_sums(
     faces: &[[u32; 3]],
     n_vertices: usize,
@@ -1010,9 +1012,4 @@ fn integer_forms(
         }
     }
     forms
-}
-
-/// UV triangle of element `el` for the unknown vector `x`.
-fn unknown_uv(el: &Element, x: &[f64]) -> [[f64; 2]; 3] {
-    [0, 1, 2].map(|k| [x[el.x[0][k]], x[el.x[1][k]]])
 }
