@@ -84,3 +84,82 @@ fn quads_writes_a_quad_obj_and_its_report() {
     assert_eq!(bad.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `solve --quads` into a `.glb`: read back as the file's f32, every seam
+/// transition is a quarter turn plus an integer translation to the last bit
+/// and every cone an integer point, with coordinates of up to about 64 grid
+/// units (where a plain f32 rounding is off by ~4e-6).
+#[test]
+fn a_grid_glb_is_an_integer_grid_map_in_f32() {
+    let spot = common::shared_path("spot.obj");
+    let dir = std::env::temp_dir().join(format!("conemap-grid-glb-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let glb = dir.join("spot-grid.glb");
+    let out = Command::new(env!("CARGO_BIN_EXE_conemap")).arg("solve").arg(&spot).arg("-o").arg(&glb).args(["--quads", "10000", "--quiet"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&glb).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    let g = gltf::Gltf::from_slice(&bytes).unwrap();
+    let blob = g.blob.clone().unwrap();
+    // Triangles as (welded position id, uv) corners; positions welded by their f32 bits.
+    let mut ids = std::collections::HashMap::new();
+    let mut corners: Vec<(usize, [f64; 2])> = Vec::new();
+    for mesh in g.meshes() {
+        for prim in mesh.primitives() {
+            let r = prim.reader(|_| Some(&blob[..]));
+            let pos: Vec<[f32; 3]> = r.read_positions().unwrap().collect();
+            let tex: Vec<[f32; 2]> = r.read_tex_coords(0).unwrap().into_f32().collect();
+            for i in r.read_indices().unwrap().into_u32() {
+                let key = pos[i as usize].map(f32::to_bits);
+                let n = ids.len();
+                let id = *ids.entry(key).or_insert(n);
+                // TEXCOORD_0 = (u, 1 − v) in grid units.
+                let t = tex[i as usize];
+                corners.push((id, [t[0] as f64, 1.0 - t[1] as f64]));
+            }
+        }
+    }
+    let extent = corners.iter().map(|c| c.1[0].abs().max(c.1[1].abs())).fold(0.0, f64::max);
+    assert!(extent > 32.0, "coordinates up to {extent}: too small to test f32 exactness");
+    // Each undirected edge with its two sides: (corner a, corner b) per face.
+    let mut sides: std::collections::HashMap<(usize, usize), Vec<(usize, usize)>> = std::collections::HashMap::new();
+    for f in 0..corners.len() / 3 {
+        for k in 0..3 {
+            let (a, b) = (3 * f + k, 3 * f + (k + 1) % 3);
+            let key = (corners[a].0.min(corners[b].0), corners[a].0.max(corners[b].0));
+            sides.entry(key).or_default().push(if corners[a].0 < corners[b].0 { (a, b) } else { (b, a) });
+        }
+    }
+    let rot = |p: [f64; 2], r: u8| match r {
+        0 => p,
+        1 => [-p[1], p[0]],
+        2 => [-p[0], -p[1]],
+        _ => [p[1], -p[0]],
+    };
+    let (mut seams, mut worst) = (0, 0f64);
+    for pair in sides.values().filter(|s| s.len() == 2) {
+        let [(a0, b0), (a1, b1)] = [pair[0], pair[1]];
+        let (ua, ub, va, vb) = (corners[a0].1, corners[b0].1, corners[a1].1, corners[b1].1);
+        if ua == va && ub == vb {
+            continue;
+        }
+        seams += 1;
+        let d0 = [ub[0] - ua[0], ub[1] - ua[1]];
+        let d1 = [vb[0] - va[0], vb[1] - va[1]];
+        let r = (0..4u8).min_by(|&x, &y| {
+            let (p, q) = (rot(d0, x), rot(d0, y));
+            let e = |p: [f64; 2]| (p[0] - d1[0]).powi(2) + (p[1] - d1[1]).powi(2);
+            e(p).total_cmp(&e(q))
+        });
+        let r = r.unwrap();
+        for (u, v) in [(ua, va), (ub, vb)] {
+            let ru = rot(u, r);
+            for i in 0..2 {
+                let t = v[i] - ru[i];
+                worst = worst.max((t - t.round()).abs());
+            }
+        }
+    }
+    assert!(seams > 100, "{seams} seam edges");
+    assert_eq!(worst, 0.0, "a seam translation is off an integer by {worst:.2e} in the file");
+}

@@ -163,7 +163,7 @@ fn glb_round_trip_splits_exactly_at_seams() {
     // 6 sides × 4 corners: split along every cube edge (all are seams here).
     assert_eq!(distinct_wedges(&mesh, &uv), 24);
     assert_eq!(back.positions.len(), 24);
-    assert_eq!(input.output_vertex_count(), 24);
+    assert_eq!(input.output_vertex_count(&ExportOptions::default()), 24);
 
     // TEXCOORD_0 = (u', 1 − v') with the documented normalisation.
     let norm = UvNormalization::of(&uv);
@@ -205,7 +205,7 @@ fn no_seam_means_no_split() {
     let (raw, uv) = grid(6);
     let mesh = TriMesh::from_raw(&raw).unwrap();
     let input = ExportInput::new(&raw, &mesh, &uv).unwrap();
-    assert_eq!(input.output_vertex_count(), mesh.n_vertices());
+    assert_eq!(input.output_vertex_count(&ExportOptions::default()), mesh.n_vertices());
     let glb = export::write_glb(&input, &ExportOptions::default());
     let read = read_gltf(&glb);
     assert_eq!(read.vertices, 49);
@@ -225,7 +225,7 @@ fn no_seam_means_no_split() {
     }
     let input = ExportInput::new(&raw, &mesh, &seamed).unwrap();
     assert_eq!(distinct_wedges(&mesh, &seamed), 49 + 7);
-    assert_eq!(input.output_vertex_count(), 49 + 7);
+    assert_eq!(input.output_vertex_count(&ExportOptions::default()), 49 + 7);
 }
 
 #[test]

@@ -744,7 +744,7 @@ fn solve_report(
     report["output"] = serde_json::json!({
         "path": written.path,
         "format": format!("{:?}", written.format).to_ascii_lowercase(),
-        "vertices": input.output_vertex_count(),
+        "vertices": input.output_vertex_count(written.options),
         "faces": mesh.n_faces(),
         "bytes": written.bytes,
         "uv_normalization": {"offset": input.uv_normalization(written.options).offset, "scale": input.uv_normalization(written.options).scale},
@@ -806,7 +806,7 @@ fn print_solution(file: &str, solution: &conemap::pipeline::Solution, alignment:
     for note in written.input.notes() {
         println!("  note: {note}");
     }
-    println!("  wrote {}: {} vertices, {} faces", written.path, written.input.output_vertex_count(), mesh.n_faces());
+    println!("  wrote {}: {} vertices, {} faces", written.path, written.input.output_vertex_count(written.options), mesh.n_faces());
     let (t_import, t_cones, t_param, t_export, total) = (times.import, times.cones, times.param, times.export, times.total());
     println!(
         "  time: import {t_import:.3} s, cones {t_cones:.3} s, parametrization {t_param:.3} s, export {t_export:.3} s, total {total:.3} s"

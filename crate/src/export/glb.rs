@@ -144,7 +144,7 @@ impl GltfBuffer {
 /// The glTF JSON and the (4-byte padded) binary buffer. With `embed`, the
 /// buffer is written into the JSON as a data URI.
 fn document(input: &ExportInput, options: &ExportOptions, embed: bool) -> (Value, Vec<u8>) {
-    let layout = input.layout();
+    let layout = input.layout(&input.written_uv(options));
     let normals = input.normals();
     let norm = input.uv_normalization(options);
     let mut bin = GltfBuffer::default();

@@ -57,8 +57,14 @@ pub use png::checker_png;
 
 use crate::io::gltf::GltfSource;
 use crate::io::InputFile;
+use crate::quads::exact_grid_uv;
 use crate::{RawMesh, TriMesh};
+use std::borrow::Cow;
 use std::collections::HashMap;
+
+/// Grid-unit UVs within this distance of an integer (and seam translations
+/// within it of an integer vector) are written as exactly integer.
+const GRID_SNAP_TOLERANCE: f64 = 1e-6;
 
 /// Output formats, picked from a file name's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -245,9 +251,30 @@ impl<'a> ExportInput<'a> {
         &self.notes
     }
 
-    /// Number of output vertices (distinct (source vertex, UV) wedges).
-    pub fn output_vertex_count(&self) -> usize {
-        self.layout().groups.iter().map(|g| g.wedges.len()).sum()
+    /// Number of output vertices (distinct (source vertex, UV) wedges) when
+    /// written with `options`.
+    pub fn output_vertex_count(&self, options: &ExportOptions) -> usize {
+        self.layout(&self.written_uv(options)).groups.iter().map(|g| g.wedges.len()).sum()
+    }
+
+    /// The corner UVs the writers store with `options`: as given, or, in
+    /// grid units, made exact for f32 ([`exact_grid_uv`]) with as many
+    /// fractional bits as the centred coordinates leave in a 24-bit
+    /// mantissa, so that the file's seam translations are integers and its
+    /// cones integer points to the last bit (as given when `uv` is not an
+    /// integer-grid map).
+    fn written_uv(&self, options: &ExportOptions) -> Cow<'a, [[f64; 2]]> {
+        if !options.grid_units || self.uv.is_empty() {
+            return Cow::Borrowed(self.uv);
+        }
+        let centre = UvNormalization::grid(self.uv).offset;
+        let extent = self.uv.iter().map(|p| (p[0] - centre[0]).abs().max((p[1] - centre[1]).abs())).fold(0.0, f64::max);
+        // (|x| + 2)·2^bits ≤ 2^24 keeps x and the glTF 1 − x exact in f32.
+        let bits = (24.0 - (extent + 2.0).log2()).floor().clamp(0.0, 32.0) as u32;
+        match exact_grid_uv(self.mesh, self.uv, GRID_SNAP_TOLERANCE, bits) {
+            Some(exact) => Cow::Owned(exact),
+            None => Cow::Borrowed(self.uv),
+        }
     }
 
     /// The UV normalisation the writers apply with `options`.
@@ -289,7 +316,7 @@ impl<'a> ExportInput<'a> {
     }
 
     /// Output primitives with their wedges and local triangles.
-    fn layout(&self) -> Layout {
+    fn layout(&self, uv: &[[f64; 2]]) -> Layout {
         let nf = self.raw.triangles.len();
         let ranges: Vec<(std::ops::Range<usize>, Option<usize>)> = match &self.source {
             Some(s) if !s.groups.is_empty() => s.groups.iter().map(|g| (g.triangles.clone(), g.material)).collect(),
@@ -307,7 +334,7 @@ impl<'a> ExportInput<'a> {
                 let mut tri = [0u32; 3];
                 for (k, slot) in tri.iter_mut().enumerate() {
                     let s = self.raw.triangles[f][k];
-                    let uv = self.uv[3 * f + k];
+                    let uv = uv[3 * f + k];
                     // Adding 0.0 turns -0.0 into +0.0, so the two compare equal.
                     let key = (s, (uv[0] + 0.0).to_bits(), (uv[1] + 0.0).to_bits());
                     *slot = *map.entry(key).or_insert_with(|| {

@@ -15,7 +15,7 @@ use std::fmt::Write;
 
 /// The OBJ text of `input`.
 pub fn write_obj(input: &ExportInput, options: &ExportOptions) -> String {
-    let layout = input.layout();
+    let layout = input.layout(&input.written_uv(options));
     let normals = input.normals();
     let norm = input.uv_normalization(options);
     let raw = input.raw;

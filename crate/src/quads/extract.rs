@@ -134,6 +134,28 @@ pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) 
     Ok(QuadMesh { positions, locations, quads: cells.quads, uv: cells.uv, defects })
 }
 
+/// The integer-grid map `uv` (one UV per face corner, grid units) made exact
+/// in binary floating point: every coordinate a multiple of `2^-bits`
+/// (`bits ≤ 32`), integers within `tol` snapped to them, and the corners
+/// set so that across every interior edge the two sides differ exactly by
+/// a quarter-turn rotation and an integer translation. Any float type whose
+/// mantissa holds `|coordinate|·2^bits` keeps those relations exactly (an
+/// f32 when it is below 2^24). `None` when `uv` is not an integer-grid map
+/// within `tol` (the snap would move corners) or not finite and within
+/// [`MAX_UV`].
+pub fn exact_grid_uv(mesh: &TriMesh, uv: &[[f64; 2]], tol: f64, bits: u32) -> Option<Vec<[f64; 2]>> {
+    let valid = uv.len() == 3 * mesh.n_faces()
+        && uv.iter().all(|p| p.iter().all(|x| x.is_finite() && x.abs() <= MAX_UV))
+        && bits <= 32;
+    if !valid {
+        return None;
+    }
+    let one = 1i64 << bits;
+    let mut defects = Vec::new();
+    let map = snap::snap_at(mesh, uv, tol, one, &mut defects);
+    defects.is_empty().then(|| map.uv.iter().map(|p| p.map(|x| x as f64 / one as f64)).collect())
+}
+
 /// The input face and barycentric coordinates of the integer point `uv`
 /// (home chart of `place`, see [`vertices::QuadVertex`]).
 fn surface_point(mesh: &TriMesh, map: &snap::SnappedMap, place: Place, uv: snap::Point) -> SurfacePoint {

@@ -108,13 +108,14 @@ impl SnappedMap {
     }
 }
 
-/// `x` in fixed point, snapped to the nearest integer when within `tol` of it.
-fn snap_coordinate(x: f64, tol: f64) -> i64 {
+/// `x` in fixed point of `one` steps per grid unit, snapped to the nearest
+/// integer when within `tol` of it.
+fn snap_coordinate(x: f64, tol: f64, one: i64) -> i64 {
     let r = x.round();
     if (x - r).abs() <= tol {
-        r as i64 * ONE
+        r as i64 * one
     } else {
-        (x * ONE as f64).round() as i64
+        (x * one as f64).round() as i64
     }
 }
 
@@ -131,6 +132,12 @@ fn snap_coordinate(x: f64, tol: f64) -> i64 {
 /// transitions do not close up on the master (holonomy that does not fix
 /// it), or a cone whose UV is not an integer point, is recorded as a defect.
 pub(super) fn snap(mesh: &TriMesh, uv: &[[f64; 2]], tol: f64, defects: &mut Vec<QuadDefect>) -> SnappedMap {
+    snap_at(mesh, uv, tol, ONE, defects)
+}
+
+/// [`snap`] in a fixed point of `one` steps per grid unit (a power of two
+/// at most [`ONE`]); the points are then in that fixed point.
+pub(super) fn snap_at(mesh: &TriMesh, uv: &[[f64; 2]], tol: f64, one: i64, defects: &mut Vec<QuadDefect>) -> SnappedMap {
     let n3 = 3 * mesh.n_faces();
     let mut transition = vec![Transition::IDENTITY; n3];
     for h in 0..n3 as u32 {
@@ -162,7 +169,7 @@ pub(super) fn snap(mesh: &TriMesh, uv: &[[f64; 2]], tol: f64, defects: &mut Vec<
             let tb = uv[gb][i] - rb[i];
             let ti = (0.5 * (ta + tb)).round();
             off = off.max((ta - ti).abs()).max((tb - ti).abs());
-            t[i] = ti as i64 * ONE;
+            t[i] = ti as i64 * one;
         }
         if off > tol {
             defects.push(QuadDefect {
@@ -182,7 +189,7 @@ pub(super) fn snap(mesh: &TriMesh, uv: &[[f64; 2]], tol: f64, defects: &mut Vec<
     for v in 0..mesh.n_vertices() as u32 {
         let h0 = mesh.vertex_halfedge(v);
         let m = uv[h0 as usize];
-        let master = [snap_coordinate(m[0], tol), snap_coordinate(m[1], tol)];
+        let master = [snap_coordinate(m[0], tol, one), snap_coordinate(m[1], tol, one)];
         fixed[h0 as usize] = master;
         let (mut cur, mut p, mut turns) = (h0, master, 0u32);
         for _ in 0..mesh.n_halfedges() {
@@ -198,7 +205,7 @@ pub(super) fn snap(mesh: &TriMesh, uv: &[[f64; 2]], tol: f64, defects: &mut Vec<
                 // Inconsistent transitions drifted out of range: restart from
                 // this corner's own UV (the fan is broken there anyway).
                 let own = uv[nxt as usize];
-                p = [snap_coordinate(own[0], tol), snap_coordinate(own[1], tol)];
+                p = [snap_coordinate(own[0], tol, one), snap_coordinate(own[1], tol, one)];
                 defects.push(QuadDefect {
                     face: nxt / 3,
                     what: format!("transitions around vertex {v} drift out of range; corner taken as given"),
@@ -210,7 +217,7 @@ pub(super) fn snap(mesh: &TriMesh, uv: &[[f64; 2]], tol: f64, defects: &mut Vec<
                         face: h0 / 3,
                         what: format!("transitions around vertex {v} do not close up on its UV; the last edge of its fan is inconsistent"),
                     });
-                } else if turns % 4 != 0 && !(is_integer(master[0]) && is_integer(master[1])) {
+                } else if turns % 4 != 0 && !(master[0].rem_euclid(one) == 0 && master[1].rem_euclid(one) == 0) {
                     defects.push(QuadDefect {
                         face: h0 / 3,
                         what: format!("cone at vertex {v} is not on an integer point"),
