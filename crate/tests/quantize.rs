@@ -134,13 +134,14 @@ fn spot_3000_quads() {
     assert_eq!(run("spot.obj", None, 3000), (0, 0));
 }
 
-/// Known shortfall (docs/STATUS.md): two triangles between nearby feature
-/// isolines collapse onto one grid line at 3 000 quads, and a vertex near
-/// them winds; integers, seams and isolines hold.
+/// Cones beside feature isolines less than a cell away, and isolines
+/// determined through seams, are kept a grid line apart (param::separation):
+/// nothing flips. Known shortfall (docs/STATUS.md): the map still winds
+/// around two vertices near a cone (one of them counts as off the grid).
 #[test]
 fn fandisk_sharp_60_3000_quads() {
     let (flipped, off_grid) = run("fandisk.obj", Some(60.0), 3000);
-    assert!(flipped <= 2 && off_grid <= 1, "{flipped} flipped, {off_grid} off the grid");
+    assert!(flipped == 0 && off_grid <= 1, "{flipped} flipped, {off_grid} off the grid");
 }
 
 #[test]
@@ -148,31 +149,60 @@ fn bunny_1000_quads() {
     assert_eq!(run("bff-bunny.obj", None, 1000), (0, 0));
 }
 
+/// Extracts and checks the quad mesh of `name`'s integer-grid map at about
+/// `n` quads: no defect, the input's Euler characteristic, boundary loops
+/// and one component, pure valid quads as many as the map's cells, within
+/// 1 % of the input both ways, every sharp edge on quad edges, at most
+/// `max_degenerate` degenerate quads (a bow-tie in 3D). Returns the
+/// report and the solution's cones by valence `4 - k`.
+fn quad_mesh(name: &str, sharp: Option<f64>, n: usize, max_degenerate: usize) -> (conemap::quads::QuadReport, std::collections::BTreeMap<u32, usize>) {
+    use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
+    let input = load(name);
+    let features = sharp.map_or_else(|| FeatureSet::none(&input), |deg| FeatureSet::sharp_edges(&input, deg));
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(n), &mut |_, _| {}).unwrap();
+    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
+    assert!(quads.defects.is_empty(), "{name}: {:?}", &quads.defects[..quads.defects.len().min(5)]);
+    let sharp_edges: Vec<u32> = solution.features.edges().collect();
+    let r = check_quads(&solution.mesh, &quads, &CheckOptions { sharp_edges: &sharp_edges, ..CheckOptions::default() });
+    let chi = solution.mesh.n_vertices() as i64 - solution.mesh.n_edges() as i64 + solution.mesh.n_faces() as i64;
+    let loops = solution.mesh.boundary_loops().len();
+    assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (chi, loops, 1), "{name}");
+    assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.flipped_quads), (0, 0, 0), "{name}");
+    assert!(r.degenerate_quads <= max_degenerate, "{name}: {} degenerate quads", r.degenerate_quads);
+    assert!((r.quads as f64 - map.report.cells).abs() < 1.0, "{name}: {} quads, {} cells", r.quads, map.report.cells);
+    assert!(r.distance_quads_to_input_relative.unwrap() < 0.01 && r.distance_input_to_quads_relative.unwrap() < 0.01, "{name}: {r:?}");
+    if !sharp_edges.is_empty() {
+        assert_eq!(r.fraction_sharp_within_tolerance, Some(1.0), "{name}: sharp edges off the quad edges");
+    }
+    let mut cones = std::collections::BTreeMap::new();
+    for c in &solution.placement.cones {
+        *cones.entry((4 - c.k) as u32).or_default() += 1;
+    }
+    (r, cones)
+}
+
 /// The quad mesh of spot's integer-grid map: closed, Euler characteristic
 /// 2, pure valid quads, singular vertices exactly the cones with valence
 /// `4 - k`, on the surface.
 #[test]
 fn spot_quad_mesh() {
-    use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
-    let input = load("spot.obj");
-    let features = FeatureSet::none(&input);
-    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
-    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
-    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
-    assert!(quads.defects.is_empty(), "{:?}", &quads.defects[..quads.defects.len().min(5)]);
-    let r = check_quads(&solution.mesh, &quads, &CheckOptions::default());
-    assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (2, 0, 1));
-    assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.degenerate_quads, r.flipped_quads), (0, 0, 0, 0));
-    assert!((r.quads as f64 - map.report.cells).abs() < 1.0, "{} quads, {} cells", r.quads, map.report.cells);
-    // Singular vertices = cones, valence 4 - k.
-    let mut expected: std::collections::BTreeMap<u32, usize> = std::collections::BTreeMap::new();
-    for c in &solution.placement.cones {
-        *expected.entry((4 - c.k) as u32).or_default() += 1;
-    }
+    let (r, cones) = quad_mesh("spot.obj", None, 3000, 0);
     let found: std::collections::BTreeMap<u32, usize> = r.valence_histogram.interior.iter().filter(|(&v, _)| v != 4).map(|(&v, &n)| (v, n)).collect();
-    assert_eq!(found, expected);
-    assert!(r.distance_quads_to_input_relative.unwrap() < 0.01 && r.distance_input_to_quads_relative.unwrap() < 0.01, "{r:?}");
+    assert_eq!(found, cones);
     assert!(r.angle_mean_deviation < 7.1, "mean corner-angle deviation {}", r.angle_mean_deviation);
+}
+
+/// Fandisk with its creases (> 60°) at 10 000 quads and alligator with its
+/// boundary at 3 000 give closed-up
+/// quad meshes with the input's topology (known shortfall, docs/STATUS.md:
+/// fandisk at 3 000 still winds around two vertices, and at 10 000 one quad
+/// is a bow-tie in 3D).
+#[test]
+fn feature_and_boundary_quad_meshes() {
+    let (r, _) = quad_mesh("fandisk.obj", Some(60.0), 10000, 1);
+    assert!(r.angle_mean_deviation < 10.1, "fandisk: mean corner-angle deviation {}", r.angle_mean_deviation);
+    quad_mesh("alligator.obj", None, 3000, 0);
 }
 
 /// The same quantizer serves a second grid size (the page re-runs only this

@@ -33,6 +33,7 @@ pub mod injective;
 pub mod metrics;
 pub mod quantize;
 pub mod seamless;
+mod separation;
 pub mod untangle;
 #[cfg(test)]
 mod tests;

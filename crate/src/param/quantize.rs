@@ -17,7 +17,12 @@
 //! `(I - r) p`, and the two sides of a half-turn seam from a corner `P` to a
 //! cone `p` satisfy `f_g(P) + f_f(P) = 2 p`, so rounding the cone later could
 //! leave it half-way between grid points. A triangle whose three corners
-//! are rounded forms of one coordinate is never put onto one grid line.
+//! are rounded forms of one coordinate is never put onto one grid line, and
+//! two integers that the surface between them keeps apart (a cone beside a
+//! feature isoline, two parallel isolines less than a cell apart: see
+//! [`super::separation`]) are rounded a line apart; where the other forms
+//! determine them on one line anyway (through a seam's translation, say),
+//! [`Quantizer::separate`] moves the integers that determine them.
 //!
 //! Then [`Quantizer::polish`]: the untangler under all the integer rows
 //! where the map folds, and ARAP local/global iterations (eq. 4), each kept
@@ -27,7 +32,9 @@
 //! and the moved map is polished too; the better of the two is returned.
 //!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
-//! batch (the rows change; about ten batches), one per `uncollapse` trial
+//! batch (the rows change; about ten batches), with that factorization two
+//! adjoint solves per violated separation and one solve per move tried (at
+//! most [`SEPARATION_TRIALS`] per batch), one per `uncollapse` trial
 //! (at most [`UNCOLLAPSE_TRIALS`], only where the map is bad), and one
 //! solve per ARAP iteration with the last factorization.
 
@@ -39,6 +46,7 @@ use super::seamless::{
     closest_rotation, curve_rotation, curve_wedge_pairs, elements, factored, seam_rows,
     stiffness_triplets, unknowns, RowSet,
 };
+use super::separation::{self, Separation};
 use super::untangle::{untangle, UntangleOptions};
 use super::{ParamError, Parametrization};
 use crate::clock::Stopwatch;
@@ -71,6 +79,19 @@ const WOUND_WEIGHT: usize = 16;
 
 /// Integer moves tried against flipped or collapsed triangles, at most.
 const UNCOLLAPSE_TRIALS: usize = 40;
+
+/// Re-solves spent restoring separations after a batch, at most.
+const SEPARATION_TRIALS: usize = 200;
+
+/// Moves that mend one separation by breaking another, at most per batch.
+const SIDEWAYS_MOVES: usize = 8;
+
+/// Integers tried per violated separation.
+const CANDIDATES_PER_SEPARATION: usize = 16;
+
+/// Unknowns of bad triangles whose sensitivities pick the integers
+/// [`Quantizer::uncollapse`] tries, at most per round.
+const UNCOLLAPSE_PROBES: usize = 48;
 
 /// Relative residual of every solve.
 const SOLVE_TOLERANCE: f64 = 1e-12;
@@ -171,6 +192,13 @@ pub struct QuantizeReport {
     pub translation_forms: usize,
     /// Rounding batches (each one KKT analysis + factorization).
     pub batches: usize,
+    /// Integers moved by one to keep separated forms a grid line apart
+    /// ([`Quantizer::separate`]).
+    pub separation_moves: usize,
+    /// Pairs of forms to be kept a grid line apart, and those left closer
+    /// (each one a collapse).
+    pub separations: usize,
+    pub separations_violated: usize,
     /// Integers moved by one to undo a collapse ([`Quantizer::uncollapse`]).
     pub moved_integers: usize,
     /// ARAP iterations kept after the rounding.
@@ -214,6 +242,12 @@ pub struct Quantizer {
     /// one coordinate each (rounding all three to one integer collapses the
     /// triangle onto a grid line).
     triples: Vec<Vec<[usize; 3]>>,
+    /// Pairs of forms that must stay a grid line apart, and per form the
+    /// indices of those it is in.
+    separations: Vec<Separation>,
+    separations_of: Vec<Vec<usize>>,
+    /// Per unknown: the form that is that unknown alone (`usize::MAX` if none).
+    form_of: Vec<usize>,
     /// Per component: the pin wedge's two unknowns.
     pins: Vec<[usize; 2]>,
     /// The seamless map's unknowns (model units).
@@ -273,7 +307,11 @@ impl Quantizer {
             .iter()
             .map(|&p| [vars[0][p as usize], vars[1][p as usize]])
             .collect();
-        let triples = collapse_triples(&elements, &forms, n_unknowns);
+        let form_of = single_unknown_forms(&forms, n_unknowns);
+        let triples = collapse_triples(&elements, &forms, &form_of);
+        let integral = integral_unknowns(mesh, placement, &cut, &vars, &param.uv, n_unknowns, &forms);
+        let separations = separation::separations(&elements, &integral, &seamless);
+        let separations_of = separation::by_form(&separations, &form_of, forms.len());
         let faces = mesh.faces().to_vec();
         let seamless_areas: Vec<f64> = (0..nf)
             .map(|f| signed_uv_area([param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]))
@@ -294,6 +332,9 @@ impl Quantizer {
             n_unknowns,
             forms,
             triples,
+            separations,
+            separations_of,
+            form_of,
             pins,
             seamless,
             map_area,
@@ -333,6 +374,7 @@ impl Quantizer {
         let mut order: Vec<usize> = Vec::new();
         let mut x = x0.clone();
         let mut batches = 0;
+        let mut separation_moves = 0;
         let mut system = None;
         for kind in [FormKind::Cone, FormKind::Point, FormKind::Translation] {
             loop {
@@ -380,6 +422,8 @@ impl Quantizer {
                     batch.retain(|i| !conflicting.contains(i));
                     batch.splice(0..0, conflicting);
                 };
+                let mut solved = solved;
+                separation_moves += self.separate(&mut solved, &mut values, &x0, &targets)?;
                 x = solved.x.clone();
                 // A candidate the batch's other forms already determine takes the
                 // value the solve gives it.
@@ -407,10 +451,10 @@ impl Quantizer {
             if bad > 0 && UNCOLLAPSE_TRIALS > 0 {
                 let (mut moved_values, mut moved_x) = (values.clone(), rounded);
                 let moves = self.uncollapse(
-                    &order,
                     &mut moved_values,
                     &mut moved_x,
                     &mut moved_system,
+                    &x0,
                     &targets,
                     s,
                 )?;
@@ -465,6 +509,9 @@ impl Quantizer {
                 .filter(|f| f.kind == FormKind::Translation)
                 .count(),
             batches,
+            separation_moves,
+            separations: self.separations.len(),
+            separations_violated: self.violated_separations(&x).len(),
             moved_integers,
             arap_iterations,
             untangled,
@@ -499,12 +546,138 @@ impl Quantizer {
                     (l.min(y), h.max(y))
                 });
             if y > hi {
-                return v + 1;
+                return self.separated(i, v + 1, values);
             } else if y < lo {
-                return v - 1;
+                return self.separated(i, v - 1, values);
             }
         }
-        v
+        self.separated(i, v, values)
+    }
+
+    /// `v` moved the least so that form `i` stays a grid line apart from
+    /// every rounded form it must be separated from; `v` when no integer
+    /// meets all of them.
+    fn separated(&self, i: usize, v: i64, values: &[Option<i64>]) -> i64 {
+        let (mut lower, mut upper) = (i64::MIN, i64::MAX);
+        let value = |u: usize| self.form_of.get(u).and_then(|&f| values.get(f).copied().flatten());
+        for &k in &self.separations_of[i] {
+            let sep = self.separations[k];
+            if self.form_of[sep.hi] == i {
+                if let Some(lo) = value(sep.lo) {
+                    lower = lower.max(lo + 1);
+                }
+            } else if let Some(hi) = value(sep.hi) {
+                upper = upper.min(hi - 1);
+            }
+        }
+        if lower <= upper {
+            v.clamp(lower, upper)
+        } else {
+            v
+        }
+    }
+
+    /// Separations whose two unknowns are integers in `x` (rounded or
+    /// determined) and less than a grid line apart.
+    fn violated_separations(&self, x: &[f64]) -> Vec<Separation> {
+        self.separations
+            .iter()
+            .copied()
+            .filter(|s| {
+                distance_to_integer(x[s.lo]) < NEAR_INTEGER
+                    && distance_to_integer(x[s.hi]) < NEAR_INTEGER
+                    && x[s.hi] - x[s.lo] < 1.0 - NEAR_INTEGER
+            })
+            .collect()
+    }
+
+    /// Restores violated separations after a batch: a form the others
+    /// determine cannot be rounded apart directly, so for each violated pair
+    /// the change of its gap per unit change of every rounded integer comes
+    /// from one adjoint solve per side (`K⁻¹ [c; 0]`, the multipliers), and
+    /// the integers that widen it, closest to their seamless values first,
+    /// are tried moved by one, each re-solved with the same factorization. A
+    /// move is kept when every form stays integer and fewer separations stay
+    /// violated; when none does, the cheapest move that mends one pair at
+    /// the price of another is taken (at most [`SIDEWAYS_MOVES`], never back
+    /// to a state seen before), since the collapse often moves along a chain
+    /// of isolines before it finds room. Returns the moves kept.
+    fn separate(
+        &self,
+        system: &mut RoundedSystem,
+        values: &mut [Option<i64>],
+        x0: &[f64],
+        targets: &[[[f64; 2]; 2]],
+    ) -> Result<usize, QuantizeError> {
+        let mut violated = self.violated_separations(&system.x);
+        let (mut moves, mut trials, mut sideways) = (0, 0, 0);
+        let mut seen = std::collections::HashSet::new();
+        seen.insert(values.to_vec());
+        while !violated.is_empty() && trials < SEPARATION_TRIALS {
+            let mut best: Option<SeparationMove> = None;
+            let mut improved = false;
+            'pairs: for sep in violated.clone() {
+                let gain_hi = system.sensitivity(&[(sep.hi, 1)])?;
+                let gain_lo = system.sensitivity(&[(sep.lo, 1)])?;
+                let mut candidates: Vec<(f64, usize, usize, i64)> = system
+                    .form_rows
+                    .iter()
+                    .filter_map(|&(form, row)| {
+                        let gain = gain_hi[row] - gain_lo[row];
+                        let v = values[form]?;
+                        (gain.abs() > 0.5).then(|| {
+                            let step = if gain > 0.0 { 1 } else { -1 };
+                            let cost = ((v + step) as f64 - self.forms[form].value(x0)).abs();
+                            (cost, form, row, step)
+                        })
+                    })
+                    .collect();
+                candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+                for &(_, form, row, step) in candidates.iter().take(CANDIDATES_PER_SEPARATION) {
+                    if trials >= SEPARATION_TRIALS {
+                        break 'pairs;
+                    }
+                    let mut trial = values.to_vec();
+                    trial[form] = Some(values[form].unwrap_or(0) + step);
+                    if seen.contains(&trial) {
+                        continue;
+                    }
+                    trials += 1;
+                    system.b[row] += step as f64;
+                    let x = system.resolve(self, targets)?;
+                    system.b[row] -= step as f64;
+                    let integral = trial.iter().zip(&self.forms).all(|(v, f)| {
+                        v.is_none() || distance_to_integer(f.value(&x)) < NEAR_INTEGER
+                    });
+                    if !integral {
+                        continue;
+                    }
+                    let after = self.violated_separations(&x);
+                    if after.len() < violated.len() {
+                        best = Some(SeparationMove { row, step, x, values: trial, violated: after });
+                        improved = true;
+                        break 'pairs;
+                    }
+                    if best.is_none() && after.len() == violated.len() && !after.contains(&sep) {
+                        best = Some(SeparationMove { row, step, x, values: trial, violated: after });
+                    }
+                }
+            }
+            let Some(SeparationMove { row, step, x, values: trial, violated: after }) = best else { break };
+            if !improved {
+                if sideways == SIDEWAYS_MOVES {
+                    break;
+                }
+                sideways += 1;
+            }
+            system.b[row] += step as f64;
+            system.x = x;
+            values.copy_from_slice(&trial);
+            seen.insert(trial);
+            violated = after;
+            moves += 1;
+        }
+        Ok(moves)
     }
 
     /// Untangles `x` under `system`'s rows when it folds, then runs ARAP
@@ -571,78 +744,76 @@ impl Quantizer {
         Ok((x, bad, arap_iterations, untangled))
     }
 
-    /// Where the rounded map has flipped or collapsed triangles, moves the
-    /// integers of the forms at their corners by one, one at a time, keeping
-    /// each move that leaves fewer of them (the collapse of two isolines or
-    /// cones onto one grid line is undone by putting one of them a line
-    /// further). One factorization per trial; at most [`UNCOLLAPSE_TRIALS`].
-    /// Returns the moves kept.
+    /// Where the rounded map has flipped or collapsed triangles or wound
+    /// vertices, moves by one the integers that move their corners (found by
+    /// adjoint solves as in [`Self::separate`], so a translation whose seam
+    /// passes there counts too), closest to their seamless values first,
+    /// keeping each move that leaves a less bad map ([`Self::badness`]) and
+    /// no more violated separations, every form still integer. One solve
+    /// with `system`'s factorization per trial, at most
+    /// [`UNCOLLAPSE_TRIALS`]. Returns the moves kept.
     fn uncollapse(
         &self,
-        order: &[usize],
         values: &mut [Option<i64>],
         x: &mut Vec<f64>,
         system: &mut RoundedSystem,
+        x0: &[f64],
         targets: &[[[f64; 2]; 2]],
         s: f64,
     ) -> Result<usize, QuantizeError> {
-        let mut flipped = self.flipped_faces(x, s);
         let mut badness = self.badness(x, s);
+        let violated = self.violated_separations(x).len();
         let (mut trials, mut kept) = (0, 0);
         let mut tried = std::collections::HashSet::new();
-        while !flipped.is_empty() && trials < UNCOLLAPSE_TRIALS {
-            let mut unknowns: Vec<usize> = flipped
+        while badness > 0 && trials < UNCOLLAPSE_TRIALS {
+            let mut unknowns: Vec<usize> = self
+                .flipped_faces(x, s)
                 .iter()
                 .flat_map(|&f| self.elements[f].x.iter().flatten().copied())
                 .collect();
             unknowns.sort_unstable();
             unknowns.dedup();
-            let candidates: Vec<usize> = order
+            unknowns.truncate(UNCOLLAPSE_PROBES);
+            let mut gain = vec![0.0f64; system.b.len()];
+            for &u in &unknowns {
+                for (g, d) in gain.iter_mut().zip(system.sensitivity(&[(u, 1)])?) {
+                    *g = g.max(d.abs());
+                }
+            }
+            let mut candidates: Vec<(f64, usize, usize, i64)> = system
+                .form_rows
                 .iter()
-                .copied()
-                .filter(|&i| {
-                    self.forms[i]
-                        .row
-                        .iter()
-                        .any(|(u, _)| unknowns.binary_search(u).is_ok())
+                .filter(|&&(_, row)| gain[row] > 0.5)
+                .flat_map(|&(form, row)| {
+                    let v = values[form].unwrap_or(0);
+                    let y = self.forms[form].value(x0);
+                    [1, -1].map(|step| (((v + step) as f64 - y).abs(), form, row, step))
                 })
                 .collect();
+            candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut improved = false;
-            for i in candidates {
-                let Some(v) = values[i] else { continue };
-                // Away from where the map would put it unconstrained first.
-                let y = self.forms[i].value(x);
-                for delta in if y >= v as f64 { [1, -1] } else { [-1, 1] } {
-                    if trials >= UNCOLLAPSE_TRIALS || !tried.insert((i, v + delta)) {
-                        continue;
-                    }
-                    trials += 1;
-                    let mut trial = values.to_vec();
-                    trial[i] = Some(v + delta);
-                    let (solved, dependent) = self.solve(order, &trial, x, targets)?;
-                    if dependent.iter().any(|&j| {
-                        distance_to_integer(self.forms[j].value(&solved.x)) > NEAR_INTEGER
-                    }) {
-                        continue;
-                    }
-                    let after = self.badness(&solved.x, s);
-                    if after < badness {
-                        for j in dependent {
-                            trial[j] = Some(self.forms[j].value(&solved.x).round() as i64);
-                        }
-                        values.copy_from_slice(&trial);
-                        *x = solved.x.clone();
-                        *system = solved;
-                        flipped = self.flipped_faces(x, s);
-                        badness = after;
-                        kept += 1;
-                        improved = true;
-                        break;
-                    }
+            for (_, form, row, step) in candidates {
+                let v = values[form].unwrap_or(0) + step;
+                if trials >= UNCOLLAPSE_TRIALS || !tried.insert((form, v)) {
+                    continue;
                 }
-                if improved {
+                trials += 1;
+                system.b[row] += step as f64;
+                let moved = system.resolve(self, targets)?;
+                let integral = values.iter().zip(&self.forms).all(|(v, f)| {
+                    v.is_none() || distance_to_integer(f.value(&moved)) < NEAR_INTEGER
+                });
+                let after = self.badness(&moved, s);
+                if integral && after < badness && self.violated_separations(&moved).len() <= violated {
+                    values[form] = Some(v);
+                    system.x = moved.clone();
+                    *x = moved;
+                    badness = after;
+                    kept += 1;
+                    improved = true;
                     break;
                 }
+                system.b[row] -= step as f64;
             }
             if !improved {
                 break;
@@ -749,8 +920,12 @@ impl Quantizer {
             .collect();
         let mut c = Vec::new();
         let mut b = Vec::new();
-        for ((row, k), v) in rows.iter().zip(keep).zip(rhs_rows) {
+        let mut form_rows = Vec::new();
+        for (r, ((row, k), v)) in rows.iter().zip(keep).zip(rhs_rows).enumerate() {
             if k {
+                if (n_seam..n_seam + order.len()).contains(&r) {
+                    form_rows.push((order[r - n_seam], b.len()));
+                }
                 c.extend(row.iter().map(|&(i, a)| (b.len(), i, a as f64)));
                 b.push(v);
             }
@@ -761,6 +936,7 @@ impl Quantizer {
             solver,
             c,
             b,
+            form_rows,
             n: self.n_unknowns,
             x: Vec::new(),
         };
@@ -769,16 +945,41 @@ impl Quantizer {
     }
 }
 
+/// One integer moved by [`Quantizer::separate`]: the row of `c` changed by
+/// `step`, the re-solved map, the forms' values and the separations still
+/// violated.
+struct SeparationMove {
+    row: usize,
+    step: i64,
+    x: Vec<f64>,
+    values: Vec<Option<i64>>,
+    violated: Vec<Separation>,
+}
+
 /// A factored KKT of [`Quantizer::solve`] and its constraint values.
 struct RoundedSystem {
     solver: LdltSolver,
     c: Vec<Triplet>,
     b: Vec<f64>,
+    /// The rows of `c` that are rounded forms: (form, row).
+    form_rows: Vec<(usize, usize)>,
     n: usize,
     x: Vec<f64>,
 }
 
 impl RoundedSystem {
+    /// Per row of `c`: the change of the linear form `row` of the solution
+    /// per unit change of that row's value (the multipliers of `K⁻¹ [row; 0]`,
+    /// `K` symmetric).
+    fn sensitivity(&self, row: &[(usize, i64)]) -> Result<Vec<f64>, QuantizeError> {
+        let mut rhs = vec![0.0; self.n + self.b.len()];
+        for &(i, a) in row {
+            rhs[i] += a as f64;
+        }
+        let z = self.solver.solve_many_to(&rhs, 1, SOLVE_TOLERANCE)?.0;
+        Ok(z[self.n..].to_vec())
+    }
+
     /// `q <- Z (Zᵀ A Z)⁻¹ Zᵀ q` (the untangler's preconditioner): the KKT
     /// solve for `(q, 0)`, put back onto `C q = 0` by `projector`; 0 when it fails.
     fn precondition(&self, q: &mut [f64], projector: Option<&NullSpaceProjector>) {
@@ -826,19 +1027,65 @@ impl RoundedSystem {
     }
 }
 
-/// Per form: the triples of distinct-enough single-unknown forms that hold
-/// the same coordinate of the three corners of some triangle.
-fn collapse_triples(
-    elements: &[Element],
-    forms: &[Form],
+/// Per unknown: whether the integer-grid map makes it an integer: both
+/// coordinates of every wedge of a singular point (the angle test of
+/// [`integer_forms`]) and every form of a single unknown.
+fn integral_unknowns(
+    mesh: &TriMesh,
+    placement: &ConePlacement,
+    cut: &CutGraph,
+    vars: &[Vec<usize>; 2],
+    uv: &[[f64; 2]],
     n_unknowns: usize,
-) -> Vec<Vec<[usize; 3]>> {
+    forms: &[Form],
+) -> Vec<bool> {
+    let cm = &placement.cut.mesh;
+    let singular = singular_cut_vertices(cm, uv);
+    let mut integral = vec![false; n_unknowns];
+    for f in 0..mesh.n_faces() {
+        for k in 0..3 {
+            if singular[cm.faces()[f][k] as usize] {
+                let w = cut.wedge[3 * f + k] as usize;
+                integral[vars[0][w]] = true;
+                integral[vars[1][w]] = true;
+            }
+        }
+    }
+    for form in forms {
+        if let [(u, 1)] = form.row.as_slice() {
+            integral[*u] = true;
+        }
+    }
+    integral
+}
+
+/// Per cut vertex: whether its UV angle sum in `uv` is off the straight
+/// angle (2 pi inside, pi on the boundary) by more than pi / 4.
+fn singular_cut_vertices(cm: &TriMesh, uv: &[[f64; 2]]) -> Vec<bool> {
+    let sums = corner_angle_sums(cm.faces(), cm.n_vertices(), |f| [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]);
+    (0..cm.n_vertices() as u32)
+        .map(|v| {
+            let straight = if cm.is_boundary_vertex(v) { PI } else { 2.0 * PI };
+            (sums[v as usize] - straight).abs() > FRAC_PI_4
+        })
+        .collect()
+}
+
+/// Per unknown: the form that is that unknown alone (a singular point's
+/// coordinate or an isoline constant), `usize::MAX` where there is none.
+fn single_unknown_forms(forms: &[Form], n_unknowns: usize) -> Vec<usize> {
     let mut form_of = vec![usize::MAX; n_unknowns];
     for (i, f) in forms.iter().enumerate() {
         if let (FormKind::Cone | FormKind::Point, [(u, 1)]) = (f.kind, f.row.as_slice()) {
             form_of[*u] = i;
         }
     }
+    form_of
+}
+
+/// Per form: the triples of distinct-enough single-unknown forms that hold
+/// the same coordinate of the three corners of some triangle.
+fn collapse_triples(elements: &[Element], forms: &[Form], form_of: &[usize]) -> Vec<Vec<[usize; 3]>> {
     let mut triples = vec![Vec::new(); forms.len()];
     for el in elements {
         for c in 0..2 {
@@ -932,9 +1179,7 @@ fn integer_forms(
     uv: &[[f64; 2]],
 ) -> Vec<Form> {
     let cm = &placement.cut.mesh;
-    let sums = corner_angle_sums(cm.faces(), cm.n_vertices(), |f| {
-        [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]
-    });
+    let singular = singular_cut_vertices(cm, uv);
     let mut set = RowSet::default();
     let mut forms = Vec::new();
     let mut push = |mut row: Vec<(usize, i64)>,
@@ -955,13 +1200,7 @@ fn integer_forms(
     for (f, face) in cm.faces().iter().enumerate() {
         for k in 0..3 {
             let cv = face[k] as usize;
-            let straight = if cm.is_boundary_vertex(face[k]) {
-                PI
-            } else {
-                2.0 * PI
-            };
-            if (sums[cv] - straight).abs() > FRAC_PI_4
-                && !std::mem::replace(&mut represented[cv], true)
+            if singular[cv] && !std::mem::replace(&mut represented[cv], true)
             {
                 let w = cut.wedge[3 * f + k] as usize;
                 let kind = if cm.is_boundary_vertex(face[k]) {
