@@ -144,6 +144,22 @@ fn fandisk_sharp_60_3000_quads() {
     assert!(flipped == 0 && off_grid <= 1, "{flipped} flipped, {off_grid} off the grid");
 }
 
+/// At a coarse grid the moves of `separate` and `uncollapse` run (spot at
+/// 1 000 quads): the forms they move others by stay at their integers.
+#[test]
+fn spot_1000_quads_keep_their_integers() {
+    let input = load("spot.obj");
+    let features = FeatureSet::none(&input);
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1000), &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert!(r.moved_integers + r.separation_moves > 0, "no move ran: {r:?}");
+    assert_eq!((r.conflicts, r.flipped), (0, 0), "{r:?}");
+    assert!(r.integer_residual < 1e-9, "{r:?}");
+    let (flipped, _) = check_integer_grid("spot.obj", &solution.mesh, &features, &map.uv);
+    assert_eq!(flipped, 0);
+}
+
 #[test]
 fn bunny_1000_quads() {
     assert_eq!(run("bff-bunny.obj", None, 1000), (0, 0));

@@ -577,6 +577,16 @@ impl Quantizer {
         }
     }
 
+    /// Every rounded form set to its (integer) value in `x`: a move of one
+    /// integer moves the forms it determines by integers too.
+    fn take_determined_values(&self, values: &mut [Option<i64>], x: &[f64]) {
+        for (value, form) in values.iter_mut().zip(&self.forms) {
+            if value.is_some() {
+                *value = Some(form.value(x).round() as i64);
+            }
+        }
+    }
+
     /// Separations whose two unknowns are integers in `x` (rounded or
     /// determined) and less than a grid line apart.
     fn violated_separations(&self, x: &[f64]) -> Vec<Separation> {
@@ -673,7 +683,8 @@ impl Quantizer {
             system.b[row] += step as f64;
             system.x = x;
             values.copy_from_slice(&trial);
-            seen.insert(trial);
+            self.take_determined_values(values, &system.x);
+            seen.insert(values.to_vec());
             violated = after;
             moves += 1;
         }
@@ -806,6 +817,7 @@ impl Quantizer {
                 let after = self.badness(&moved, s);
                 if integral && after < badness && self.violated_separations(&moved).len() <= violated {
                     values[form] = Some(v);
+                    self.take_determined_values(values, &moved);
                     system.x = moved.clone();
                     *x = moved;
                     badness = after;
