@@ -215,6 +215,11 @@ export interface QuantizeReport {
   point_forms: number;
   translation_forms: number;
   batches: number;
+  /** Integers moved by one to keep separated integers a grid line apart. */
+  separation_moves: number;
+  /** Pairs of integers (cones, corners, isolines side by side) to be kept a grid line apart, and those left closer. */
+  separations: number;
+  separations_violated: number;
   /** Integers moved by one to undo a collapse. */
   moved_integers: number;
   arap_iterations: number;
@@ -291,7 +296,8 @@ export interface QuadsResult {
 }
 
 export const QUANTIZE_REPORT_KEYS = {
-  grid_size: true, point_forms: true, translation_forms: true, batches: true, moved_integers: true, arap_iterations: true,
+  grid_size: true, point_forms: true, translation_forms: true, batches: true, separation_moves: true, separations: true,
+  separations_violated: true, moved_integers: true, arap_iterations: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
   wound_vertices: true, cells: true, seconds: true,
 } as const satisfies Keys<QuantizeReport>;
