@@ -1,7 +1,7 @@
 // End-to-end test of the quad mode of the built page (dist/) in headless
 // Chromium via playwright-core: the fandisk with its sharp edges solved, then
 // the quads of the map at a count set on the slider, their figures, legend,
-// overlay and downloads. Run after `npm run build`.
+// overlay, the grid map in the UV view and the downloads. Run after `npm run build`.
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
@@ -24,6 +24,37 @@ const hooks = () => page.evaluate(() => window.__conemap);
 async function waitForQuads(runs) {
   await page.waitForFunction((n) => window.__conemap.quadRuns > n && document.body.dataset.quads !== 'running', runs, { timeout: QUADS_TIMEOUT });
   return hooks();
+}
+
+/** The larger side of bounds [min u, min v, max u, max v]. */
+const extent = (b) => Math.max(b[2] - b[0], b[3] - b[1]);
+
+/** Asserts that the UV view draws the integer-grid map of the quads in hooks `h` (their bounds, grid units, with grid lines). */
+function assertGridLayout(h) {
+  const uv = h.uvView;
+  assert.equal(uv?.map, 'grid', 'the UV view draws the grid map');
+  assert.deepEqual(uv.bounds, h.quads.uvBounds, 'the UV view is fit to the grid UVs');
+  assert.ok(extent(uv.bounds) > 10, `grid map extent ${extent(uv.bounds)} cells`);
+  assert.ok(Number.isInteger(uv.gridStride) && uv.gridStride >= 1, `grid stride ${uv.gridStride}`);
+}
+
+/**
+ * Moves the pointer from off the views onto the centroid of face `f` in the UV
+ * view: some face is highlighted (hover sync) and the pointer lies within its
+ * triangle as drawn, so no farther from its centroid than its farthest corner
+ * (the grid map has degenerate triangles: not always `f` itself).
+ */
+async function hoverUvFace(f) {
+  await page.mouse.move(5, 5);
+  await page.waitForFunction(() => window.__conemap.hoverFace === null, null, { timeout: 5_000 });
+  const p = await page.evaluate((face) => window.__conemapTest.projectUvFace(face), f);
+  assert.ok(p, 'no UV layout');
+  await page.mouse.move(p.x, p.y);
+  await page.waitForFunction(() => window.__conemap.hoverFace !== null, null, { timeout: 5_000 });
+  const g = (await hooks()).hoverFace;
+  const q = await page.evaluate((face) => window.__conemapTest.projectUvFace(face), g);
+  const d = Math.hypot(q.x - p.x, q.y - p.y);
+  assert.ok(d <= q.radius + 1, `hovered face ${g} (for ${f}) is ${d.toFixed(1)} px from the pointer, radius ${q.radius.toFixed(1)} px`);
 }
 
 /** The `f` lines of an OBJ text, each as its vertex references. */
@@ -54,6 +85,9 @@ describe('quad mode', () => {
     assert.equal(await page.getByTestId('quad-count').isEnabled(), false, 'the slider waits for quad mode');
     assert.equal(await page.getByTestId('quad-target').innerText(), '3,000');
     assert.equal(h.quads, null);
+    assert.equal(h.uvView?.map, 'seamless');
+    assert.deepEqual(h.uvView.bounds, h.result.uvBounds);
+    assert.equal(h.uvView.gridStride, null, 'no grid lines on the seamless map');
   });
 
   it('computes about 2000 quads from the slider; a newer count supersedes an older one', async () => {
@@ -74,6 +108,9 @@ describe('quad mode', () => {
     assert.equal(q.quadIndices, 4 * q.quads);
     assert.equal(q.uvCorners, 3 * h.stats.faces, 'grid UVs for every face corner');
     assert.equal(q.gridChecker, true, 'the checker is drawn from the grid UVs');
+    assertGridLayout(h);
+    // Hover sync on the grid layout: the face under the pointer in the UV view is highlighted.
+    for (const f of [0, 100, Math.floor(h.stats.faces / 2)]) await hoverUvFace(f);
     assert.ok(q.gridSize > 0);
     assert.ok(q.singular.three + q.singular.five + q.singular.other > 0, 'the fandisk has singular vertices');
     assert.equal(await page.getByTestId('quad-target').innerText(), '2,000');
@@ -98,6 +135,22 @@ describe('quad mode', () => {
     await page.getByTestId('show-quads').check();
   });
 
+  it('switching the quad count redraws the UV view with the new grid map', async () => {
+    let h = await hooks();
+    const before = h.uvView.bounds;
+    await page.evaluate(() => window.__conemapTest.setQuadCount(500));
+    h = await waitForQuads(h.quadRuns);
+    assert.equal(h.quads?.target, 500, h.quadsError ?? '');
+    assertGridLayout(h);
+    // A quarter of the cells: about half the extent.
+    const ratio = extent(h.uvView.bounds) / extent(before);
+    assert.ok(ratio > 0.3 && ratio < 0.7, `extent ratio ${ratio} for 500 / 2000 quads`);
+    await page.evaluate(() => window.__conemapTest.setQuadCount(2000));
+    h = await waitForQuads(h.quadRuns);
+    assert.equal(h.quads?.target, 2000, h.quadsError ?? '');
+    assertGridLayout(h);
+  });
+
   it('downloads the quad mesh as .obj (quads only, the count shown) and .glb, and the grid-UV .glb', async () => {
     const q = (await hooks()).quads;
     const [obj] = await Promise.all([page.waitForEvent('download'), page.getByTestId('download-quads-obj').click()]);
@@ -114,10 +167,13 @@ describe('quad mode', () => {
     }
   });
 
-  it('turns quad mode off back to the seamless checker, and a new solve drops the quads', async () => {
+  it('turns quad mode off back to the seamless checker and UV layout, and a new solve drops the quads', async () => {
     await page.getByTestId('quad-mode').uncheck();
     let h = await hooks();
     assert.equal(h.quads, null);
+    assert.equal(h.uvView?.map, 'seamless', 'the UV view is back to the seamless map');
+    assert.deepEqual(h.uvView.bounds, h.result.uvBounds);
+    assert.equal(h.uvView.gridStride, null);
     assert.equal(await page.evaluate(() => document.body.dataset.quads), undefined);
     assert.equal(await page.getByTestId('quad-legend').isVisible(), false);
     assert.equal(await page.getByTestId('download-quads-obj').isEnabled(), false);
@@ -131,6 +187,7 @@ describe('quad mode', () => {
     h = await waitForQuads(quadRuns);
     assert.equal(h.state, 'solved');
     assert.equal(h.quads?.target, 2000, h.quadsError ?? '');
+    assertGridLayout(h);
   });
 
   it('logged no unexpected console errors', () => {

@@ -1,7 +1,7 @@
 // Unit tests of the page's pure modules (web/src/topology.ts, features.ts,
-// solve-view.ts, state.ts, dom.ts) and the pure functions of quad-panel.ts and
-// quad-view.ts: each is bundled by esbuild to an ES module and imported, so
-// the tests run the page's code itself, without a browser.
+// solve-view.ts, state.ts, uv-grid.ts, dom.ts) and the pure functions of
+// quad-panel.ts and quad-view.ts: each is bundled by esbuild to an ES module
+// and imported, so the tests run the page's code itself, without a browser.
 import { before, describe, it } from 'node:test';
 import assert from 'node:assert/strict';
 import { loadPageModule as load } from './wasm.mjs';
@@ -165,6 +165,8 @@ describe('solve-view.ts', () => {
       for (let i = 0; i < seg.length; i += 3) assert.equal(seg[i + 2], Math.fround(0.005));
       const layout = sv.layoutGeometry(uv);
       assert.deepEqual(layout.layoutBounds, [0, 0, 2, 2]);
+      assert.deepEqual(sv.uvBounds(uv), [0, 0, 2, 2]);
+      assert.deepEqual(sv.uvBounds(new Float32Array(0)), [Infinity, Infinity, -Infinity, -Infinity]);
       assert.ok(Math.abs(layout.layoutSphere[2] - Math.SQRT2) < 1e-6);
       const checker = sv.checkerUv(uv);
       assert.equal(Math.max(...checker) - Math.min(...checker), 2.5);
@@ -340,6 +342,38 @@ describe('quad-panel.ts and quad-view.ts', () => {
     assert.deepEqual([...seg], [0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 1, 0]);
     assert.deepEqual(view.valenceCounts(Uint32Array.from([7, 3, 8, 5, 9, 3, 10, 6])), { three: 2, five: 1, other: 1 });
     assert.deepEqual(view.valenceCounts(new Uint32Array(0)), { three: 0, five: 0, other: 0 });
+  });
+});
+
+describe('uv-grid.ts', () => {
+  let grid;
+  before(async () => { grid = await load('uv-grid'); });
+
+  it('keeps grid lines at least GRID_MIN_PX apart at a stride of 1, 2, 5, 10, 20 … cells', () => {
+    assert.equal(grid.GRID_MIN_PX, 4);
+    assert.equal(grid.gridStride(6.6), 1);
+    assert.equal(grid.gridStride(4), 1);
+    assert.equal(grid.gridStride(3.9), 2);
+    assert.equal(grid.gridStride(1), 5);
+    assert.equal(grid.gridStride(0.5), 10);
+    assert.equal(grid.gridStride(0.05), 100);
+    assert.equal(grid.gridStride(0.03), 200);
+    assert.equal(grid.gridStride(0), null);
+    assert.equal(grid.gridStride(NaN), null);
+    assert.deepEqual([1, 2, 5, 10, 20, 50].map(grid.majorStride), [10, 10, 10, 100, 100, 100]);
+  });
+
+  it('draws u = n and v = n across the bounds, multiples of the major stride apart', () => {
+    const { minor, major } = grid.gridLines([-21, -3, 24, 24], 1, 0.5);
+    // u = -21 … 24 and v = -3 … 24: 46 + 28 lines, of which u = -20, -10, 0, 10, 20 and v = 0, 10, 20 major.
+    assert.equal(major.length / 6, 8);
+    assert.equal(minor.length / 6, 46 + 28 - 8);
+    assert.deepEqual([...major.subarray(0, 6)], [-20, -3, 0.5, -20, 24, 0.5]);
+    for (let i = 0; i < major.length; i += 6) assert.ok(major[i] % 10 === 0 || major[i + 1] % 10 === 0);
+    const coarse = grid.gridLines([0.5, 0.5, 9.5, 3.5], 2, 0);
+    assert.deepEqual([...coarse.minor].filter((_, i) => i % 6 === 0), [2, 4, 6, 8, 0.5]);
+    assert.equal(coarse.major.length, 0);
+    assert.equal(grid.gridLines([Infinity, Infinity, -Infinity, -Infinity], 1, 0).minor.length, 0);
   });
 });
 

@@ -23,7 +23,11 @@ export class Editor {
       onChange: () => this.solve.featuresChanged(),
       onError: (message) => this.solve.showError(message),
     });
-    this.quads = new QuadPanel(viewer, worker, store, hooks, (message) => this.solve.showError(message), () => this.solve.hideError());
+    this.quads = new QuadPanel(viewer, worker, store, hooks, {
+      onError: (message) => this.solve.showError(message),
+      clearError: () => this.solve.hideError(),
+      onGridUv: (uv) => this.results.showGridUv(uv),
+    });
     this.results = new ResultPanel(viewer, hooks, this.quads);
     this.solve = new SolveController(viewer, worker, store, this.features, this.results, hooks);
   }

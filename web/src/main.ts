@@ -170,6 +170,7 @@ window.__conemapTest = {
   projectVertex: (v) => editor.features.projectVertex(v),
   edgeEnds: (e) => editor.features.edgeEnds(e),
   setQuadCount: (n) => editor.quads.setCount(n),
+  projectUvFace: (f) => editor.results.projectUvFace(f),
 };
 
 void listSamples();

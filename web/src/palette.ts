@@ -26,6 +26,13 @@ export function valenceColor(valence: number): number {
 /** Squares along each side of the checker texture: a UV span of 1 / CHECKER_SQUARES is one square. */
 export const CHECKER_SQUARES = 8;
 
+/** Grid-unit UVs `uv` scaled for the checker texture, one square per grid cell (a new array). */
+export function gridCheckerUv(uv: Float32Array): Float32Array {
+  const scaled = new Float32Array(uv.length);
+  for (let i = 0; i < uv.length; i++) scaled[i] = uv[i]! / CHECKER_SQUARES;
+  return scaled;
+}
+
 /** The marker colour of a cone of index `k`. */
 export function coneColor(k: number): number {
   return k === 1 ? COLORS.conePlus : k === -1 ? COLORS.coneMinus : COLORS.coneOther;

@@ -3,13 +3,15 @@
 // (a newer request supersedes the ones not yet answered), its progress line,
 // the figures (quad edge length, counts, singular vertices by valence, corner
 // angles, distortion before → after quantization, defects), the valence
-// legend and the downloads; the 3D overlay is quad-view.ts. Errors go to the
-// page's solve error box; the solved map stays shown.
+// legend and the downloads; the 3D overlay is quad-view.ts, and the UV view
+// (result-panel.ts) is told to draw the grid map while quads are shown. Errors
+// go to the page's solve error box; the solved map stays shown.
 import { $, definitionList, fmt, fmtInt, fmtMs } from './dom';
 import { downloadBytes, fileStem } from './downloads';
 import type { OpenMesh } from './feature-editor';
 import type { QuadsResult } from './protocol';
 import { QuadView, valenceCounts } from './quad-view';
+import { uvBounds } from './solve-view';
 import type { PageState, PageStore } from './state';
 import type { Hooks, QuadsHook } from './test-hooks';
 import type { Viewer } from './viewer';
@@ -24,6 +26,16 @@ export function quadsOf(s: number): number {
   const n = 10 ** s;
   const unit = 10 ** Math.max(0, Math.floor(Math.log10(n)) - 1);
   return Math.round(n / unit) * unit;
+}
+
+/** What the quad panel tells the rest of the page. */
+export interface QuadPanelEvents {
+  /** Shows a failed request's message (the page's error box). */
+  onError: (message: string) => void;
+  /** Hides that message again after a success. */
+  clearError: () => void;
+  /** The grid UVs of the quads shown (grid units, 2 per input face corner) for the UV view; null: none are shown, back to the seamless map. */
+  onGridUv: (uv: Float32Array | null) => void;
 }
 
 /** The quads shown, the count they were asked for and the milliseconds the request took. */
@@ -63,17 +75,13 @@ export class QuadPanel {
     gridGlb: $<HTMLButtonElement>('download-grid-glb'),
   };
 
-  /**
-   * Wires the controls; `onError` shows a failed request's message (the
-   * page's error box), `clearError` hides it again after a success.
-   */
+  /** Wires the controls; `events` are told of errors and of the grid UVs shown (see `QuadPanelEvents`). */
   constructor(
     private readonly viewer: Viewer,
     private readonly worker: MeshWorker,
     private readonly store: PageStore,
     private readonly hooks: Pick<Hooks, 'quads' | 'quadsError' | 'quadRuns'>,
-    private readonly onError: (message: string) => void,
-    private readonly clearError: () => void,
+    private readonly events: QuadPanelEvents,
   ) {
     this.view = new QuadView(viewer);
     const el = this.el;
@@ -169,7 +177,7 @@ export class QuadPanel {
         } else {
           this.dropShown();
           this.hooks.quadsError = outcome.error;
-          this.onError(`Quads: ${outcome.error}`);
+          this.events.onError(`Quads: ${outcome.error}`);
           this.store.setQuads('failed');
           this.render();
         }
@@ -180,12 +188,13 @@ export class QuadPanel {
     }
   }
 
-  /** Puts `s` on screen: the overlay, the figures, the legend, the downloads. */
+  /** Puts `s` on screen: the overlay, the grid map in the UV view, the figures, the legend, the downloads. */
   private show(s: Shown): void {
     const r = s.result;
     this.shown = s;
     this.view.show(r);
     this.view.setEdgesVisible(this.el.showEdges.checked);
+    this.events.onGridUv(r.uv);
     const counts = valenceCounts(r.singular);
     this.el.size.textContent = `Quad edge ${fmt(r.quantization.grid_size, 4)} (model units) · ${fmtInt(r.report.quads)} quads`;
     this.el.stats.replaceChildren(quadTable(s, counts));
@@ -198,7 +207,7 @@ export class QuadPanel {
     }
     this.hooks.quadsError = null;
     this.hooks.quads = quadsHook(s, counts, this.viewer.showsGridUv);
-    this.clearError();
+    this.events.clearError();
     this.store.setQuads('shown');
     this.render();
   }
@@ -213,8 +222,9 @@ export class QuadPanel {
     this.store.setQuads('off');
   }
 
-  /** Removes the quads shown (overlay, figures): the view goes back to the seamless map's. */
+  /** Removes the quads shown (overlay, figures): the 3D and UV views go back to the seamless map's. */
   private dropShown(): void {
+    if (this.shown) this.events.onGridUv(null);
     this.shown = null;
     this.view.clear();
     this.el.size.textContent = '';
@@ -310,5 +320,6 @@ function quadsHook(s: Shown, counts: ReturnType<typeof valenceCounts>, gridCheck
     defects: r.defects,
     uvCorners: r.uv.length / 2,
     gridChecker,
+    uvBounds: uvBounds(r.uv),
   };
 }

@@ -1,18 +1,19 @@
 // A finished solve on screen: the figures table, the cones, seams and checker
 // (or distortion) surface in the 3D view, the UV layout beside it with hover in
-// sync, the surface-mode switch with the distortion legend, and the downloads
-// (glTF, OBJ, the JSON report); the quads of the map are quad-panel.ts.
+// sync (the seamless map, or the integer-grid map while quads are shown), the
+// surface-mode switch with the distortion legend, and the downloads (glTF,
+// OBJ, the JSON report); the quads of the map are quad-panel.ts.
 import * as THREE from 'three';
 import { $, definitionList, fmt, fmtInt, fmtMs } from './dom';
 import { download, downloadBytes, fileStem } from './downloads';
 import type { OpenMesh } from './feature-editor';
-import { COLORS, heat } from './palette';
+import { COLORS, gridCheckerUv, heat } from './palette';
 import type { SolveResult, SolveView } from './protocol';
 import type { QuadPanel } from './quad-panel';
 import { afterNextFrame, latestPerFrame } from './render-loop';
-import { buildSolveView } from './solve-view';
+import { buildSolveView, cutSegments, layoutGeometry, uvBounds } from './solve-view';
 import type { Hooks, ResultHook } from './test-hooks';
-import { UvView } from './uvview';
+import { type UvLayout, UvView } from './uvview';
 import type { SurfaceMode, Viewer } from './viewer';
 
 /** A solve's result as shown, with the mesh it was solved on and the settings it ran with. */
@@ -27,6 +28,8 @@ export class ResultPanel {
   /** Bumped whenever the shown result is cleared: a view build that sees it change stops. */
   private epoch = 0;
   private readonly uvView: UvView;
+  /** The seamless map's layout of the result shown (null before it is on screen). */
+  private seamless: UvLayout | null = null;
   private readonly el = {
     results: $('results'),
     resultStats: $('result-stats'),
@@ -43,11 +46,12 @@ export class ResultPanel {
   /** `quads` is told of every map shown and cleared. */
   constructor(
     private readonly viewer: Viewer,
-    private readonly hooks: Pick<Hooks, 'result' | 'hoverFace'>,
+    private readonly hooks: Pick<Hooks, 'result' | 'hoverFace' | 'uvView'>,
     private readonly quads: QuadPanel,
   ) {
     this.uvView = new UvView(this.el.uv);
     this.uvView.onHover = (face) => this.hoverSync(face);
+    this.uvView.onDrawn = (drawn) => (this.hooks.uvView = drawn);
     this.wireHover();
     this.wireControls();
   }
@@ -61,6 +65,7 @@ export class ResultPanel {
   clear(): void {
     this.epoch++;
     this.shown = null;
+    this.seamless = null;
     this.hooks.result = null;
     this.el.results.hidden = true;
     this.el.uv.hidden = true;
@@ -118,10 +123,11 @@ export class ResultPanel {
       if (!live()) return false;
       // The UV layout, in the next frame.
       this.el.uv.hidden = false;
-      this.uvView.show({
-        uv: r.uv, positions: view.layoutPositions, checkerUv: view.checkerUv, colors,
+      this.seamless = {
+        map: 'seamless', uv: r.uv, positions: view.layoutPositions, checkerUv: view.checkerUv, colors,
         outline: view.cutSegments, bounds: view.layoutBounds, sphere: view.layoutSphere,
-      });
+      };
+      this.uvView.show(this.seamless);
       this.uvView.setColored(this.surfaceMode() === 'distortion');
       await this.uvView.loop.prepare();
       if (!live()) return false;
@@ -134,6 +140,30 @@ export class ResultPanel {
     this.hooks.result = figures;
     if (hasUv) this.quads.setMap(m);
     return true;
+  }
+
+  /**
+   * Draws the integer-grid map `uv` (grid units, 2 per face corner, as the
+   * seamless UVs) in the UV view, framed, with its grid lines; null goes back
+   * to the seamless map. Ignored until the seamless layout is on screen; a
+   * `uv` of another length shows the seamless map.
+   */
+  showGridUv(uv: Float32Array | null): void {
+    const seamless = this.seamless;
+    if (!this.shown || !seamless) return;
+    if (uv && uv.length === seamless.uv.length) {
+      this.uvView.show(gridLayout(this.shown.mesh, this.shown.result, uv, seamless.colors));
+    } else if (this.uvView.map !== 'seamless') {
+      this.uvView.show(seamless);
+    } else {
+      return;
+    }
+    this.uvView.setColored(this.surfaceMode() === 'distortion');
+  }
+
+  /** Page position (client CSS px) of the centroid of face `face` in the UV view and its farthest corner's distance; null when no layout is shown. */
+  projectUvFace(face: number): { x: number; y: number; radius: number } | null {
+    return this.uvView.projectFace(face);
   }
 
   /** The report: settings, features, mesh figures and the solver's result (without bulky arrays); null without a result. */
@@ -256,6 +286,7 @@ function resultFigures(m: OpenMesh, r: SolveResult): ResultHook {
     seams: r.seam_edges.length,
     energy: r.energy,
     helperComponents: r.helperComponents ?? 0,
+    uvBounds: r.uv.length > 0 ? uvBounds(r.uv) : null,
   };
 }
 
@@ -308,6 +339,16 @@ function statsTable(m: OpenMesh, r: SolveResult, f: ResultHook): HTMLDListElemen
   const coneDd = list.querySelector<HTMLElement>('dd[data-stat=cones]');
   if (coneDd) coneDd.dataset['testid'] = 'cone-count';
   return list;
+}
+
+/** The UV layout of the integer-grid map `uv` of result `r` on mesh `m` (its chart outlines along the same seams), coloured by `colors` (the seamless map's distortion, as in the 3D view). */
+function gridLayout(m: OpenMesh, r: SolveResult, uv: Float32Array, colors: Float32Array | null): UvLayout {
+  const g = layoutGeometry(uv);
+  return {
+    map: 'grid', uv, positions: g.layoutPositions, checkerUv: gridCheckerUv(uv), colors,
+    outline: cutSegments(uv, m.data.faceEdges, m.edges.length / 2, r.seam_edges ?? new Uint32Array(0), m.data.boundary),
+    bounds: g.layoutBounds, sphere: g.layoutSphere,
+  };
 }
 
 /** The display arrays of result `r` on mesh `m` built on this thread (when the worker sent none). */

@@ -73,24 +73,32 @@ export function distortionView(perFace: Float32Array): NonNullable<SolveView['di
   return { colors, max, histogram };
 }
 
-/** The UV layout as xyz per corner (z = 0) with its bounds and bounding sphere (as three.js computes them). */
-export function layoutGeometry(uv: Float32Array): Pick<SolveView, 'layoutPositions' | 'layoutBounds' | 'layoutSphere'> {
-  const corners = uv.length / 2;
-  const pos = new Float32Array(corners * 3);
+/** [min u, min v, max u, max v] of `uv` (2 per corner); infinite when it is empty. */
+export function uvBounds(uv: Float32Array): [number, number, number, number] {
   let minX = Infinity;
   let minY = Infinity;
   let maxX = -Infinity;
   let maxY = -Infinity;
-  for (let c = 0; c < corners; c++) {
-    const x = uv[2 * c]!;
-    const y = uv[2 * c + 1]!;
-    pos[3 * c] = x;
-    pos[3 * c + 1] = y;
+  for (let i = 0; i + 1 < uv.length; i += 2) {
+    const x = uv[i]!;
+    const y = uv[i + 1]!;
     if (x < minX) minX = x;
     if (x > maxX) maxX = x;
     if (y < minY) minY = y;
     if (y > maxY) maxY = y;
   }
+  return [minX, minY, maxX, maxY];
+}
+
+/** The UV layout as xyz per corner (z = 0) with its bounds and bounding sphere (as three.js computes them). */
+export function layoutGeometry(uv: Float32Array): Pick<SolveView, 'layoutPositions' | 'layoutBounds' | 'layoutSphere'> {
+  const corners = uv.length / 2;
+  const pos = new Float32Array(corners * 3);
+  for (let c = 0; c < corners; c++) {
+    pos[3 * c] = uv[2 * c]!;
+    pos[3 * c + 1] = uv[2 * c + 1]!;
+  }
+  const [minX, minY, maxX, maxY] = uvBounds(uv);
   const cx = (minX + maxX) / 2;
   const cy = (minY + maxY) / 2;
   let r2 = 0;

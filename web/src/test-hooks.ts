@@ -4,6 +4,7 @@
 import type { Stats } from './panels';
 import type { ErrorLocation } from './protocol';
 import type { PageStore, Phase } from './state';
+import type { UvDrawn } from './uvview';
 
 /** Figures of a finished solve, as the tests read them. */
 export interface ResultHook {
@@ -26,6 +27,8 @@ export interface ResultHook {
   energy: number;
   /** Components whose cones a helper worker placed. */
   helperComponents: number;
+  /** [min u, min v, max u, max v] of the seamless map (null without UVs). */
+  uvBounds: [number, number, number, number] | null;
 }
 
 /** Figures of the quads shown, as the tests read them. */
@@ -48,6 +51,8 @@ export interface QuadsHook {
   uvCorners: number;
   /** The 3D checker is drawn from the grid UVs. */
   gridChecker: boolean;
+  /** [min u, min v, max u, max v] of the grid UVs (grid units). */
+  uvBounds: [number, number, number, number];
 }
 
 /** `window.__conemap`: each part of the page keeps its fields up to date. */
@@ -76,6 +81,8 @@ export interface Hooks {
   solves: number;
   /** Face highlighted in the 3D and UV views (hover sync), or null. */
   hoverFace: number | null;
+  /** What the UV view draws: which map, the bounds of its triangles, the grid-line stride (null when no layout is shown). */
+  uvView: UvDrawn | null;
   /** Figures of the quads shown (null when none are). */
   quads: QuadsHook | null;
   /** Message of the last failed quads request (null after a success). */
@@ -103,6 +110,8 @@ export interface TestActions {
   edgeEnds(e: number): [number, number] | null;
   /** Sets the quad-count slider to about `n` quads and asks for them at once (quad mode must be on). */
   setQuadCount(n: number): void;
+  /** Page position (client CSS px) of the centroid of face `face` in the UV view, and the distance from it to the farthest corner; null when no layout is shown. */
+  projectUvFace(face: number): { x: number; y: number; radius: number } | null;
 }
 
 declare global {
@@ -121,7 +130,7 @@ export function installHooks(store: PageStore): Hooks {
     },
     stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
     features: 0, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
-    quads: null, quadsError: null, quadRuns: 0,
+    uvView: null, quads: null, quadsError: null, quadRuns: 0,
   };
   window.__conemap = hooks;
   return hooks;

@@ -8,7 +8,7 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
 import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
 import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
-import { CHECKER_SQUARES, COLORS, checkerTexture, coneColor } from './palette';
+import { COLORS, checkerTexture, coneColor, gridCheckerUv } from './palette';
 import type { Cone } from './protocol';
 import { RenderLoop, createRenderer } from './render-loop';
 import { edgeSegments } from './solve-view';
@@ -180,11 +180,7 @@ export class Viewer {
    */
   setGridUv(uv: Float32Array | null): void {
     if (!this.uvMesh || !this.surfaceUv || (uv && uv.length !== this.surfaceUv.length)) return;
-    let shown = this.surfaceUv;
-    if (uv) {
-      shown = new Float32Array(uv.length);
-      for (let i = 0; i < uv.length; i++) shown[i] = uv[i]! / CHECKER_SQUARES;
-    }
+    const shown = uv ? gridCheckerUv(uv) : this.surfaceUv;
     this.uvMesh.geometry.setAttribute('uv', new THREE.BufferAttribute(shown, 2));
     this.gridUvShown = uv !== null;
     this.loop.request();
