@@ -88,6 +88,11 @@ pub(super) fn build_quads(
             defects.push(QuadDefect { face, what: "grid cell is not closed; skipped".into() });
         } else if cycle.len() != 4 {
             defects.push(QuadDefect { face, what: format!("grid cell has {} sides; skipped", cycle.len()) });
+        } else if {
+            let q = [0, 1, 2, 3].map(|i| qv.slot_owner[cycle[i] as usize]);
+            (0..4).any(|i| (i + 1..4).any(|j| q[i] == q[j]))
+        } {
+            defects.push(QuadDefect { face, what: "grid cell repeats a vertex (the map winds around it there); skipped".into() });
         } else {
             cells.quads.push([0, 1, 2, 3].map(|i| qv.slot_owner[cycle[i] as usize]));
             let dir = qv.slots[x as usize].dir;
