@@ -32,11 +32,12 @@
 //! and the moved map is polished too; the better of the two is returned.
 //!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
-//! batch (the rows change; about ten batches), with that factorization two
-//! adjoint solves per violated separation and one solve per move tried (at
-//! most [`SEPARATION_TRIALS`] per batch), one per `uncollapse` trial
-//! (at most [`UNCOLLAPSE_TRIALS`], only where the map is bad), and one
-//! solve per ARAP iteration with the last factorization.
+//! batch (the rows change; about ten batches). With that factorization:
+//! one adjoint solve per violated separation and one solve per move tried
+//! (at most [`SEPARATION_TRIALS`] per batch); after the last batch, one
+//! adjoint solve per probed unknown and one solve per `uncollapse` trial
+//! (at most [`UNCOLLAPSE_TRIALS`], only where the map is bad), and one solve
+//! per ARAP iteration.
 
 use super::cut_graph::{cut_graph, CutGraph};
 use super::element::{signed_uv_area, Element};
@@ -293,6 +294,7 @@ impl Quantizer {
             }
         }
         let component = wedge_components(&cut);
+        let singular = singular_cut_vertices(&placement.cut.mesh, &param.uv);
         let forms = integer_forms(
             mesh,
             placement,
@@ -300,7 +302,7 @@ impl Quantizer {
             &cut,
             &vars,
             &component,
-            &param.uv,
+            &singular,
         );
         let pins = cut
             .pins
@@ -309,7 +311,7 @@ impl Quantizer {
             .collect();
         let form_of = single_unknown_forms(&forms, n_unknowns);
         let triples = collapse_triples(&elements, &forms, &form_of);
-        let integral = integral_unknowns(mesh, placement, &cut, &vars, &param.uv, n_unknowns, &forms);
+        let integral = integral_unknowns(mesh, placement, &cut, &vars, &singular, n_unknowns, &forms);
         let separations = separation::separations(&elements, &integral, &seamless);
         let separations_of = separation::by_form(&separations, &form_of, forms.len());
         let faces = mesh.faces().to_vec();
@@ -577,6 +579,11 @@ impl Quantizer {
         }
     }
 
+    /// Whether every rounded form (`values` set) is an integer in `x`.
+    fn rounded_forms_integral(&self, values: &[Option<i64>], x: &[f64]) -> bool {
+        values.iter().zip(&self.forms).all(|(v, f)| v.is_none() || distance_to_integer(f.value(x)) < NEAR_INTEGER)
+    }
+
     /// Every rounded form set to its (integer) value in `x`: a move of one
     /// integer moves the forms it determines by integers too.
     fn take_determined_values(&self, values: &mut [Option<i64>], x: &[f64]) {
@@ -604,7 +611,7 @@ impl Quantizer {
     /// Restores violated separations after a batch: a form the others
     /// determine cannot be rounded apart directly, so for each violated pair
     /// the change of its gap per unit change of every rounded integer comes
-    /// from one adjoint solve per side (`K⁻¹ [c; 0]`, the multipliers), and
+    /// from one adjoint solve (`K⁻¹ [c; 0]`, the multipliers), and
     /// the integers that widen it, closest to their seamless values first,
     /// are tried moved by one, each re-solved with the same factorization. A
     /// move is kept when every form stays integer and fewer separations stay
@@ -627,13 +634,13 @@ impl Quantizer {
             let mut best: Option<SeparationMove> = None;
             let mut improved = false;
             'pairs: for sep in violated.clone() {
-                let gain_hi = system.sensitivity(&[(sep.hi, 1)])?;
-                let gain_lo = system.sensitivity(&[(sep.lo, 1)])?;
+                // The gap x_hi - x_lo is linear: one adjoint solve for it.
+                let gap_gain = system.sensitivity(&[(sep.hi, 1), (sep.lo, -1)])?;
                 let mut candidates: Vec<(f64, usize, usize, i64)> = system
                     .form_rows
                     .iter()
                     .filter_map(|&(form, row)| {
-                        let gain = gain_hi[row] - gain_lo[row];
+                        let gain = gap_gain[row];
                         let v = values[form]?;
                         (gain.abs() > 0.5).then(|| {
                             let step = if gain > 0.0 { 1 } else { -1 };
@@ -656,10 +663,7 @@ impl Quantizer {
                     system.b[row] += step as f64;
                     let x = system.resolve(self, targets)?;
                     system.b[row] -= step as f64;
-                    let integral = trial.iter().zip(&self.forms).all(|(v, f)| {
-                        v.is_none() || distance_to_integer(f.value(&x)) < NEAR_INTEGER
-                    });
-                    if !integral {
+                    if !self.rounded_forms_integral(&trial, &x) {
                         continue;
                     }
                     let after = self.violated_separations(&x);
@@ -811,11 +815,8 @@ impl Quantizer {
                 trials += 1;
                 system.b[row] += step as f64;
                 let moved = system.resolve(self, targets)?;
-                let integral = values.iter().zip(&self.forms).all(|(v, f)| {
-                    v.is_none() || distance_to_integer(f.value(&moved)) < NEAR_INTEGER
-                });
                 let after = self.badness(&moved, s);
-                if integral && after < badness && self.violated_separations(&moved).len() <= violated {
+                if self.rounded_forms_integral(values, &moved) && after < badness && self.violated_separations(&moved).len() <= violated {
                     values[form] = Some(v);
                     self.take_determined_values(values, &moved);
                     system.x = moved.clone();
@@ -1040,19 +1041,18 @@ impl RoundedSystem {
 }
 
 /// Per unknown: whether the integer-grid map makes it an integer: both
-/// coordinates of every wedge of a singular point (the angle test of
-/// [`integer_forms`]) and every form of a single unknown.
+/// coordinates of every wedge of a `singular` cut vertex
+/// ([`singular_cut_vertices`]) and every form of a single unknown.
 fn integral_unknowns(
     mesh: &TriMesh,
     placement: &ConePlacement,
     cut: &CutGraph,
     vars: &[Vec<usize>; 2],
-    uv: &[[f64; 2]],
+    singular: &[bool],
     n_unknowns: usize,
     forms: &[Form],
 ) -> Vec<bool> {
     let cm = &placement.cut.mesh;
-    let singular = singular_cut_vertices(cm, uv);
     let mut integral = vec![false; n_unknowns];
     for f in 0..mesh.n_faces() {
         for k in 0..3 {
@@ -1188,10 +1188,9 @@ fn integer_forms(
     cut: &CutGraph,
     vars: &[Vec<usize>; 2],
     component: &[usize],
-    uv: &[[f64; 2]],
+    singular: &[bool],
 ) -> Vec<Form> {
     let cm = &placement.cut.mesh;
-    let singular = singular_cut_vertices(cm, uv);
     let mut set = RowSet::default();
     let mut forms = Vec::new();
     let mut push = |mut row: Vec<(usize, i64)>,

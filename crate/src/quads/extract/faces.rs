@@ -86,15 +86,17 @@ pub(super) fn build_quads(
         let face = qv.slots[x as usize].face;
         if !closed {
             defects.push(QuadDefect { face, what: "grid cell is not closed; skipped".into() });
-        } else if cycle.len() != 4 {
+            continue;
+        }
+        if cycle.len() != 4 {
             defects.push(QuadDefect { face, what: format!("grid cell has {} sides; skipped", cycle.len()) });
-        } else if {
-            let q = [0, 1, 2, 3].map(|i| qv.slot_owner[cycle[i] as usize]);
-            (0..4).any(|i| (i + 1..4).any(|j| q[i] == q[j]))
-        } {
+            continue;
+        }
+        let quad = [0, 1, 2, 3].map(|i| qv.slot_owner[cycle[i] as usize]);
+        if (0..4).any(|i| (i + 1..4).any(|j| quad[i] == quad[j])) {
             defects.push(QuadDefect { face, what: "grid cell repeats a vertex (the map winds around it there); skipped".into() });
         } else {
-            cells.quads.push([0, 1, 2, 3].map(|i| qv.slot_owner[cycle[i] as usize]));
+            cells.quads.push(quad);
             let dir = qv.slots[x as usize].dir;
             let p = qv.slot_origin(mesh, map, x);
             let (a, b) = (axis(dir), axis((dir + 1) % 4));
