@@ -7,11 +7,13 @@
 //!    edges, at mesh vertices) with their outgoing isoline directions;
 //! 3. `trace::trace_edge`: each direction's unit isoline segment followed
 //!    exactly to the next integer point;
-//! 4. `faces::build_quads`: the cycles of traced half-edges are the quads.
+//! 4. `faces::build_quads`: the cycles of traced half-edges are the quads;
+//! 5. `close_polygons`: a cycle of more sides (the map winds twice around a
+//!    point in the cell) is closed with quads around an input vertex there.
 //!
 //! Every predicate after step 1 is exact integer arithmetic. Where the map is
-//! not a valid integer-grid map the extractor skips what it cannot close and
-//! records a [`QuadDefect`].
+//! not a valid integer-grid map the extractor closes or skips what it cannot
+//! trace as a quad and records a [`QuadDefect`].
 
 mod faces;
 mod snap;
@@ -85,8 +87,12 @@ impl std::error::Error for ExtractError {}
 /// one face. On a valid map the result is a pure, manifold quad mesh with
 /// the input's Euler characteristic and boundary loops, valence 4 except
 /// `4 − k` at a cone of index `k`, and every input edge on an integer isoline
-/// covered by quad edges. Where the map is invalid (flips, non-integer
-/// transitions or cones) the affected cells are skipped and listed in
+/// covered by quad edges. Where the map winds twice around a point, the
+/// cell there closes only after going around twice: it is split at repeated
+/// vertices, out-and-back isolines are dropped and the rest closed with
+/// quads around an input vertex ([`close_polygons`]), so the mesh has no
+/// hole there. Where the map is otherwise invalid (flips, non-integer
+/// transitions or cones) the affected cells are skipped. Both are listed in
 /// [`QuadMesh::defects`]. Errs only on a wrong number of UVs or a UV that is
 /// not finite or beyond [`MAX_UV`]; never panics.
 pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) -> Result<QuadMesh, ExtractError> {
@@ -131,7 +137,95 @@ pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) 
         positions.push(x);
         locations.push(loc);
     }
-    Ok(QuadMesh { positions, locations, quads: cells.quads, uv: cells.uv, defects })
+    let mut quads = QuadMesh { positions, locations, quads: cells.quads, uv: cells.uv, defects };
+    close_polygons(mesh, &cells.polygons, &mut quads);
+    drop_unreferenced(&mut quads);
+    Ok(quads)
+}
+
+/// Removes the vertices no quad uses (the tip of an isoline traced out and
+/// back inside a cell the map winds around), renumbering the rest in order.
+fn drop_unreferenced(quads: &mut QuadMesh) {
+    let mut new_index = vec![u32::MAX; quads.positions.len()];
+    for q in &quads.quads {
+        for &v in q {
+            new_index[v as usize] = 0;
+        }
+    }
+    if !new_index.contains(&u32::MAX) {
+        return;
+    }
+    let mut kept = 0;
+    for (v, slot) in new_index.iter_mut().enumerate() {
+        if *slot == 0 {
+            *slot = kept;
+            quads.positions[kept as usize] = quads.positions[v];
+            quads.locations[kept as usize] = quads.locations[v];
+            kept += 1;
+        }
+    }
+    quads.positions.truncate(kept as usize);
+    quads.locations.truncate(kept as usize);
+    for q in &mut quads.quads {
+        *q = q.map(|v| new_index[v as usize]);
+    }
+}
+
+/// Closes every polygon of `2 m` corners with `m` quads around a new
+/// vertex: the input vertex nearest to the corners' centroid among those
+/// within two rings of the corners' faces (the point the map winds around
+/// lies there). Corner `2 i` of each quad is a polygon corner, so the
+/// corners alternate valence 5 and 4 and the new vertex has valence `m`.
+fn close_polygons(mesh: &TriMesh, polygons: &[faces::Polygon], quads: &mut QuadMesh) {
+    if polygons.is_empty() {
+        return;
+    }
+    let mut faces_of: Vec<Vec<u32>> = vec![Vec::new(); mesh.n_vertices()];
+    for (f, face) in mesh.faces().iter().enumerate() {
+        for &v in face {
+            faces_of[v as usize].push(f as u32);
+        }
+    }
+    for polygon in polygons {
+        let n = polygon.corners.len();
+        let centroid = polygon
+            .corners
+            .iter()
+            .fold([0.0; 3], |c, &q| crate::vec3::add(c, quads.positions[q as usize]))
+            .map(|x| x / n as f64);
+        let mut near: Vec<u32> = polygon
+            .corners
+            .iter()
+            .flat_map(|&q| mesh.faces()[quads.locations[q as usize].face as usize])
+            .collect();
+        for _ in 0..2 {
+            let grown: Vec<u32> =
+                near.iter().flat_map(|&v| faces_of[v as usize].iter().flat_map(|&f| mesh.faces()[f as usize])).collect();
+            near.extend(grown);
+            near.sort_unstable();
+            near.dedup();
+        }
+        let distance = |v: u32| {
+            let p = mesh.position(v);
+            (0..3).map(|i| (p[i] - centroid[i]).powi(2)).sum::<f64>()
+        };
+        let Some(centre) = near.iter().copied().min_by(|&a, &b| distance(a).total_cmp(&distance(b))) else {
+            continue;
+        };
+        let h0 = mesh.vertex_halfedge(centre);
+        let mut bary = [0.0; 3];
+        bary[(h0 % 3) as usize] = 1.0;
+        let m = quads.positions.len() as u32;
+        quads.positions.push(mesh.position(centre));
+        quads.locations.push(SurfacePoint { face: h0 / 3, bary });
+        let uv_mean = polygon.uv.iter().fold([0.0; 2], |c, p| [c[0] + p[0], c[1] + p[1]]).map(|x| x / n as f64);
+        for i in (0..n).step_by(2) {
+            let k = [i, i + 1, (i + 2) % n];
+            quads.quads.push([polygon.corners[k[0]], polygon.corners[k[1]], polygon.corners[k[2]], m]);
+            quads.uv.extend(k.iter().map(|&j| polygon.uv[j]));
+            quads.uv.push(uv_mean);
+        }
+    }
 }
 
 /// The integer-grid map `uv` (one UV per face corner, grid units) made exact
