@@ -1,0 +1,86 @@
+// Automated accessibility check of the whole page with axe-core, run in the
+// page: after load, with a mesh that cannot be solved (the problems list),
+// and after a solve (the results). No violation of contrast, labels, names
+// of buttons, progress bars and canvases, or of the rest of axe's WCAG A/AA
+// rules; and the focus ring of the file input shows on its button.
+import assert from 'node:assert/strict';
+import path from 'node:path';
+import { createRequire } from 'node:module';
+import { after, before, describe, it } from 'node:test';
+import { closePage, openPage, output } from './harness.mjs';
+
+const LOAD_TIMEOUT = 90_000;
+const SOLVE_TIMEOUT = 120_000;
+const axeSource = createRequire(import.meta.url).resolve('axe-core/axe.min.js');
+
+let ctx;
+let page;
+let consoleErrors = [];
+
+const hooks = () => page.evaluate(() => window.__conemap);
+
+async function waitForLoad(afterCount) {
+  await page.waitForFunction((n) => window.__conemap && window.__conemap.loads > n
+    && window.__conemap.state !== 'loading', afterCount, { timeout: LOAD_TIMEOUT });
+  return hooks();
+}
+
+/** The axe violations of the page as it is (WCAG 2.x A and AA), one line each. */
+async function violations() {
+  if (!(await page.evaluate(() => 'axe' in window))) await page.addScriptTag({ path: axeSource });
+  const result = await page.evaluate(() => window.axe.run(document, {
+    runOnly: { type: 'tag', values: ['wcag2a', 'wcag2aa', 'wcag21a', 'wcag21aa', 'best-practice'] },
+    resultTypes: ['violations'],
+  }));
+  return result.violations.map((v) => `${v.id}: ${v.nodes.slice(0, 3).map((n) => n.target.join(' ')).join(' | ')}`);
+}
+
+describe('accessibility (axe-core)', () => {
+  before(async () => {
+    ctx = await openPage();
+    ({ page, consoleErrors } = ctx);
+    await page.setViewportSize({ width: 1400, height: 900 });
+    await page.goto(ctx.server.url);
+    const h = await waitForLoad(0);
+    assert.equal(h.state, 'ready', h.lastError ?? '');
+  });
+
+  after(() => closePage(ctx));
+
+  it('has no violations after load', async () => {
+    assert.deepEqual(await violations(), []);
+  });
+
+  it('shows the focus ring of the file input on its button', async () => {
+    await page.getByTestId('file-input').focus();
+    await page.keyboard.press('Shift+Tab');
+    await page.keyboard.press('Tab');
+    const outline = await page.locator('label[for=file-input]').evaluate((el) => getComputedStyle(el).outlineStyle);
+    assert.equal(outline, 'solid');
+  });
+
+  it('has no violations with a mesh that cannot be solved (problems listed, Run off)', async () => {
+    const n = (await hooks()).loads;
+    await page.selectOption('[data-testid=samples]', 'beetle.obj');
+    await waitForLoad(n);
+    assert.equal(await page.getByTestId('run').isEnabled(), false);
+    assert.deepEqual(await violations(), []);
+  });
+
+  it('has no violations after a solve', async () => {
+    const n = (await hooks()).loads;
+    await page.selectOption('[data-testid=samples]', 'fandisk.obj');
+    await waitForLoad(n);
+    const k = (await hooks()).solves;
+    await page.getByTestId('run').click();
+    await page.waitForFunction((s) => window.__conemap.solves > s, k, { timeout: SOLVE_TIMEOUT });
+    assert.equal((await hooks()).state, 'solved');
+    await page.getByTestId('surface-distortion').check();
+    assert.deepEqual(await violations(), []);
+    await page.screenshot({ path: path.join(output, 'a11y-solved.png') });
+  });
+
+  it('logged no unexpected console errors', () => {
+    assert.deepEqual(consoleErrors, []);
+  });
+});
