@@ -88,26 +88,24 @@ describe('feature editing and the keyboard', () => {
     await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
     for (let i = 0; i < 4; i++) await page.mouse.wheel(0, -250); // larger triangles on screen
     await nextFrame();
-    // A visible edge, and a point 10 to 20 px inside a face beside it (off every edge).
-    let found = null;
-    for (let tries = 0; tries < 5 && !found; tries++) {
-      const edge = await test('visibleEdge');
-      assert.ok(edge >= 0, 'no visible edge');
-      const [a, b] = await test('edgeEnds', edge);
-      const [pa, pb] = [await test('projectVertex', a), await test('projectVertex', b)];
-      const mid = { x: (pa.x + pb.x) / 2, y: (pa.y + pb.y) / 2 };
-      const len = Math.hypot(pb.x - pa.x, pb.y - pa.y);
-      const n = { x: -(pb.y - pa.y) / len, y: (pb.x - pa.x) / len };
-      for (const s of [1, -1]) {
-        for (let d = 11; d <= 20 && !found; d++) {
-          const q = { x: mid.x + s * d * n.x, y: mid.y + s * d * n.y };
-          const pick = await test('pick', q.x, q.y);
-          if (pick && pick.sideDistance > 10 && pick.sideDistance < 20) found = { edge, mid, q, distance: pick.sideDistance };
+    // A point 10 to 20 px inside a face (off every edge: the old 24 px reach would toggle one), and a visible edge.
+    let far = null;
+    for (let tries = 0; tries < 4 && !far; tries++) {
+      far = await page.evaluate((r) => {
+        for (let y = r.y + r.height * 0.2; y < r.y + r.height * 0.8; y += 7) {
+          for (let x = r.x + r.width * 0.2; x < r.x + r.width * 0.8; x += 7) {
+            const p = window.__conemapTest.pick(x, y);
+            if (p && p.sideDistance > 10 && p.sideDistance < 20) return { x, y, distance: p.sideDistance };
+          }
         }
-      }
-      if (!found) await page.mouse.wheel(0, -250);
+        return null;
+      }, box);
+      if (!far) await page.mouse.wheel(0, -250);
     }
-    assert.ok(found, 'no point 10-20 px from the edges of a face');
+    assert.ok(far, 'no point 10-20 px from the edges of a face');
+    const edge = await test('visibleEdge');
+    assert.ok(edge >= 0, 'no visible edge');
+    const found = { edge, mid: await test('projectEdge', edge), q: far, distance: far.distance };
     const before = (await hooks()).features;
     await page.mouse.move(found.q.x, found.q.y);
     await nextFrame();
@@ -172,8 +170,12 @@ describe('feature editing and the keyboard', () => {
   });
 
   it('marks sharp edges while the slider is dragged, and undoes the drag in one step', async () => {
+    // The slider is where the last test left it (40°): back to 90° first.
     await page.getByTestId('sharp-toggle').check();
     await page.waitForFunction(() => window.__conemap.features > 0, null, { timeout: 10_000 });
+    const at40 = (await hooks()).features;
+    await page.getByTestId('sharp-angle').fill('90');
+    await page.waitForFunction((n) => window.__conemap.features !== n, at40, { timeout: 10_000 });
     const at90 = (await hooks()).features;
     const slider = await page.getByTestId('sharp-angle').boundingBox();
     const x = (deg) => slider.x + 8 + ((slider.width - 16) * deg) / 180;
@@ -195,7 +197,7 @@ describe('feature editing and the keyboard', () => {
     await page.getByTestId('undo').click();
     assert.equal((await hooks()).features, at90, 'one undo takes back the whole drag');
     assert.deepEqual(await sharpControls(), { on: true, angle: '90', shown: '90°', enabled: true });
-    await page.getByTestId('undo').click();
+    await page.getByTestId('clear-features').click();
     assert.equal((await hooks()).features, 0);
   });
 
@@ -244,7 +246,6 @@ describe('feature editing and the keyboard', () => {
   });
 
   it('Escape cancels a running solve', async () => {
-    await page.getByTestId('clear-features').click();
     await loadSample('bff-bunny.obj');
     const before = await hooks();
     await page.getByTestId('run').click();
