@@ -153,11 +153,12 @@ export class FeatureEditor {
     this.events.onChange();
   }
 
-  /** After an undo or redo (`did`): the edges, and the detection controls as the change left them. */
+  /** After an undo or redo (`did`): the edges, and the detection controls as the change left them (the counts only while they still hold). */
   private stepped(did: boolean): void {
     if (!did) return;
-    this.showSharpSettings(this.open?.features?.sharpSettings ?? null);
-    this.el.sharpStats.textContent = '';
+    const settings = this.open?.features?.sharpSettings ?? null;
+    if (JSON.stringify(settings) !== JSON.stringify(this.controlSettings())) this.el.sharpStats.textContent = '';
+    this.showSharpSettings(settings);
     this.changed(true);
   }
 
