@@ -80,6 +80,16 @@ describe('accessibility (axe-core)', () => {
     await page.screenshot({ path: path.join(output, 'a11y-solved.png') });
   });
 
+  it('fits the screen after a solve at 800×600 and 390×844: nothing below it is cut off', async () => {
+    for (const [width, height] of [[800, 600], [390, 844]]) {
+      await page.setViewportSize({ width, height });
+      await page.waitForTimeout(200);
+      const fit = await page.evaluate(() => ({ page: document.documentElement.scrollHeight, wide: document.documentElement.scrollWidth, screen: innerHeight, across: innerWidth }));
+      assert.ok(fit.page <= fit.screen && fit.wide <= fit.across, `${width}×${height}: the page is ${fit.wide}×${fit.page}`);
+    }
+    await page.setViewportSize({ width: 1400, height: 900 });
+  });
+
   it('logged no unexpected console errors', () => {
     assert.deepEqual(consoleErrors, []);
   });

@@ -116,7 +116,8 @@ export class MeshProblems {
     const pairs = problemPairs(p, this.data);
     this.viewer.setLines('problem-focus', Uint32Array.from(pairs), range(pairs.length / 2), COLORS.hover, 6, 4);
     const vertices = [...new Set([...p.vertices, ...pairs])];
-    this.viewer.setProblemVertices(p.vertices);
+    // Markers only where no line shows the problem (they are sized for the whole mesh).
+    this.viewer.setProblemVertices(pairs.length === 0 ? p.vertices : []);
     this.viewer.frameOn(vertices);
     this.hooks.problemFocus = { index: i, vertices };
   }
