@@ -77,6 +77,13 @@ describe('accessibility (axe-core)', () => {
     assert.equal((await hooks()).state, 'solved');
     await page.getByTestId('surface-distortion').check();
     assert.deepEqual(await violations(), []);
+    // The jargon of the result has plain words as tooltips.
+    const tips = await page.getByTestId('result-stats').locator('dt').evaluateAll((dts) => Object.fromEntries(dts.map((d) => [d.textContent, d.title])));
+    for (const term of ['Energy', 'φ rms', 'Σk (cones + corners)', 'Faces < 0.2 / < 0.3', 'Seam residual (angle / length)', 'Seam length']) {
+      assert.ok(tips[term]?.length > 20, `no plain-words tooltip for ${term}`);
+    }
+    assert.match(tips['Seam length'], /length units/);
+    assert.match(await page.getByTestId('cone-legend').locator('span[title]').first().getAttribute('title'), /cone of index k = \+1/);
     await page.screenshot({ path: path.join(output, 'a11y-solved.png') });
   });
 
