@@ -7,23 +7,13 @@ import assert from 'node:assert/strict';
 import path from 'node:path';
 import { createRequire } from 'node:module';
 import { after, before, describe, it } from 'node:test';
-import { closePage, openPage, output } from './harness.mjs';
+import { closePage, openReadyPage, output } from './harness.mjs';
 
-const LOAD_TIMEOUT = 90_000;
-const SOLVE_TIMEOUT = 120_000;
 const axeSource = createRequire(import.meta.url).resolve('axe-core/axe.min.js');
 
-let ctx;
-let page;
+/** The page, its context and helpers (`openReadyPage`), and the console errors it logged. */
+let ctx, page, hooks, loadSample, runSolve;
 let consoleErrors = [];
-
-const hooks = () => page.evaluate(() => window.__conemap);
-
-async function waitForLoad(afterCount) {
-  await page.waitForFunction((n) => window.__conemap && window.__conemap.loads > n
-    && window.__conemap.state !== 'loading', afterCount, { timeout: LOAD_TIMEOUT });
-  return hooks();
-}
 
 /** The axe violations of the page as it is (WCAG 2.x A and AA), one line each. */
 async function violations() {
@@ -37,12 +27,8 @@ async function violations() {
 
 describe('accessibility (axe-core)', () => {
   before(async () => {
-    ctx = await openPage();
+    ({ ctx, hooks, loadSample, runSolve } = await openReadyPage());
     ({ page, consoleErrors } = ctx);
-    await page.setViewportSize({ width: 1400, height: 900 });
-    await page.goto(ctx.server.url);
-    const h = await waitForLoad(0);
-    assert.equal(h.state, 'ready', h.lastError ?? '');
   });
 
   after(() => closePage(ctx));
@@ -60,21 +46,14 @@ describe('accessibility (axe-core)', () => {
   });
 
   it('has no violations with a mesh that cannot be solved (problems listed, Run off)', async () => {
-    const n = (await hooks()).loads;
-    await page.selectOption('[data-testid=samples]', 'beetle.obj');
-    await waitForLoad(n);
+    await loadSample('beetle.obj');
     assert.equal(await page.getByTestId('run').isEnabled(), false);
     assert.deepEqual(await violations(), []);
   });
 
   it('has no violations after a solve', async () => {
-    const n = (await hooks()).loads;
-    await page.selectOption('[data-testid=samples]', 'fandisk.obj');
-    await waitForLoad(n);
-    const k = (await hooks()).solves;
-    await page.getByTestId('run').click();
-    await page.waitForFunction((s) => window.__conemap.solves > s, k, { timeout: SOLVE_TIMEOUT });
-    assert.equal((await hooks()).state, 'solved');
+    await loadSample('fandisk.obj');
+    assert.equal((await runSolve()).state, 'solved');
     await page.getByTestId('surface-distortion').check();
     assert.deepEqual(await violations(), []);
     // The jargon of the result has plain words as tooltips.

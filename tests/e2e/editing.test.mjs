@@ -8,58 +8,16 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import { after, before, describe, it } from 'node:test';
-import { closePage, openPage, output } from './harness.mjs';
+import { closePage, openReadyPage, output } from './harness.mjs';
 
-const LOAD_TIMEOUT = 90_000;
-const SOLVE_TIMEOUT = 120_000;
-
-let ctx;
-let page;
+/** The page, its context and helpers (`openReadyPage`), and the console errors it logged. */
+let ctx, page, hooks, loadSample, runSolve, nextFrame, colourPixels;
 let consoleErrors = [];
 
-const hooks = () => page.evaluate(() => window.__conemap);
 const test = (name, ...args) => page.evaluate(([n, a]) => window.__conemapTest[n](...a), [name, args]);
-const nextFrame = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
-
-async function waitForLoad(afterCount) {
-  await page.waitForFunction((n) => window.__conemap && window.__conemap.loads > n
-    && window.__conemap.state !== 'loading', afterCount, { timeout: LOAD_TIMEOUT });
-  return hooks();
-}
-
-async function loadSample(file) {
-  const n = (await hooks()).loads;
-  await page.selectOption('[data-testid=samples]', file);
-  const h = await waitForLoad(n);
-  assert.equal(h.state, 'ready', h.lastError ?? '');
-  return h;
-}
-
-async function runSolve() {
-  const n = (await hooks()).solves;
-  await page.getByTestId('run').click();
-  await page.waitForFunction((k) => window.__conemap.solves > k, n, { timeout: SOLVE_TIMEOUT });
-  return hooks();
-}
-
 const waitFeatures = (n) => page.waitForFunction((k) => window.__conemap.features === k, n, { timeout: 10_000 });
-
 /** Pixels of the 3D view in the hover colour (COLORS.hover, #fff275). */
-async function hoverPixels() {
-  await nextFrame();
-  return page.evaluate(() => {
-    const src = document.querySelector('[data-testid=canvas]');
-    const c = document.createElement('canvas');
-    c.width = src.width;
-    c.height = src.height;
-    const g = c.getContext('2d');
-    g.drawImage(src, 0, 0);
-    const d = g.getImageData(0, 0, c.width, c.height).data;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) if (d[i] > 230 && d[i + 1] > 220 && d[i + 2] > 90 && d[i + 2] < 150) n++;
-    return n;
-  });
-}
+const hoverPixels = () => colourPixels([230, 256], [220, 256], [90, 150]);
 
 /** The sharp-edge controls as shown: ticked, slider value, its label, slider enabled. */
 async function sharpControls() {
@@ -73,12 +31,8 @@ async function sharpControls() {
 
 describe('feature editing and the keyboard', () => {
   before(async () => {
-    ctx = await openPage();
+    ({ ctx, hooks, loadSample, runSolve, nextFrame, colourPixels } = await openReadyPage());
     ({ page, consoleErrors } = ctx);
-    await page.setViewportSize({ width: 1400, height: 900 });
-    await page.goto(ctx.server.url);
-    const h = await waitForLoad(0);
-    assert.equal(h.state, 'ready', h.lastError ?? '');
   });
 
   after(() => closePage(ctx));
