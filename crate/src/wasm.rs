@@ -12,7 +12,7 @@ use crate::pipeline::{ConeStage, FeatureAlignment, RefineOptions, Solution, Solv
 use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
-use crate::mesh::{self, MeshReport, RawMesh, TriMesh};
+use crate::mesh::{self, LocatedProblem, MeshReport, RawMesh, TriMesh};
 use js_sys::{Array, Float32Array, Function, Object, Reflect, Uint32Array, Uint8Array};
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
@@ -21,6 +21,18 @@ use wasm_bindgen::prelude::*;
 #[wasm_bindgen]
 pub fn version() -> String {
     env!("CARGO_PKG_VERSION").to_string()
+}
+
+/// `alpha_smooth` when none is given, as the CLI's `--alpha` default: the
+/// paper's 0.01, or with MIQ emulation its "100.0*" (large α, no
+/// harmonic-minimality constraint).
+#[wasm_bindgen]
+pub fn default_alpha(miq: bool) -> f64 {
+    if miq {
+        cones::MIQ_ALPHA
+    } else {
+        cones::DEFAULT_ALPHA
+    }
 }
 
 /// Imports a mesh from `files` (an array of `{name: string, bytes: Uint8Array}`;
@@ -48,6 +60,9 @@ pub struct MeshSession {
     files: Vec<InputFile>,
     source: Option<GltfSource>,
     report: MeshReport,
+    /// The report's problems, named as the file numbers its elements and
+    /// located in the ids of `positions` / `triangles`.
+    problems: Vec<LocatedProblem>,
     positions: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     mesh: Option<TriMesh>,
@@ -80,17 +95,18 @@ impl MeshSession {
     pub fn open(files: Array) -> Result<MeshSession, JsError> {
         let files = input_files(&files)?;
         let (main, others) = files.split_first().ok_or_else(|| JsError::new("no file given"))?;
-        let (raw, source) = io::import_with_source(main, others).map_err(|e| JsError::new(&e.to_string()))?;
-        let report = mesh::analyze(&raw);
+        let io::Imported { raw, gltf: source, numbering } = io::import_file(main, others).map_err(|e| JsError::new(&e.to_string()))?;
+        let mesh::Located { report, welded, problems } = mesh::analyze_located(&raw, &numbering);
         let mesh = TriMesh::from_raw(&raw).ok();
         let (positions, triangles) = match &mesh {
             Some(m) => (m.positions().to_vec(), m.faces().to_vec()),
-            None => {
-                let w = mesh::weld(&raw);
-                (w.positions, w.triangles)
-            }
+            // The analysis's welding: the ids the problems are located in.
+            None => (welded.positions, welded.triangles),
         };
-        Ok(MeshSession { raw, files, source, report, positions, triangles, mesh, job: None, grid: None, refine: RefineOptions::default(), boundary: BoundaryMode::Aligned })
+        Ok(MeshSession {
+            raw, files, source, report, problems, positions, triangles, mesh, job: None, grid: None,
+            refine: RefineOptions::default(), boundary: BoundaryMode::Aligned,
+        })
     }
 
     /// Refinements around cones of angle <= 0 that solves try before they
@@ -107,11 +123,16 @@ impl MeshSession {
         self.boundary = if free { BoundaryMode::Free } else { BoundaryMode::Aligned };
     }
 
-    /// The mesh report (`MeshReport` plus `problem_messages`, one line each).
+    /// The mesh report (`MeshReport`) plus `problem_messages` (one line
+    /// each, elements numbered as the file does: OBJ 1-based, glTF by mesh,
+    /// primitive and accessor index) and `located_problems`: per problem
+    /// `{kind, message, blocking, vertices, edges (vertex pairs, flat), faces}`
+    /// in the ids of `positions()` / `indices()`.
     pub fn report(&self) -> Result<JsValue, JsError> {
         let value = serde_wasm_bindgen::to_value(&self.report).map_err(|e| JsError::new(&e.to_string()))?;
-        let messages: Array = self.report.problems.iter().map(|p| JsValue::from(p.to_string())).collect();
+        let messages: Array = self.problems.iter().map(|p| JsValue::from(p.message.as_str())).collect();
         set(&value.clone().into(), "problem_messages", &messages.into())?;
+        set(&value.clone().into(), "located_problems", &to_js(&self.problems)?)?;
         Ok(value)
     }
 
@@ -176,6 +197,17 @@ impl MeshSession {
         Ok(out.into())
     }
 
+    /// Ids of the edges a features file or JSON report (`text`, see
+    /// `io::parse_feature_edges`) names by their end positions; throws
+    /// saying which edge does not match this mesh, or what the file lacks.
+    pub fn features_from_json(&self, text: &str) -> Result<Uint32Array, JsError> {
+        let mesh = self.valid_mesh()?;
+        let edges = io::parse_feature_edges(text).map_err(|e| JsError::new(&e))?;
+        let set = FeatureSet::from_positions(mesh, &edges).map_err(|e| JsError::new(&format!("{e}: the file does not match this mesh")))?;
+        let ids: Vec<u32> = set.edges().collect();
+        Ok(Uint32Array::from(&ids[..]))
+    }
+
     /// Places cones with `feature_edges` (edge ids) as features.
     /// `progress(stage: string, step: number, remaining: number)` is called
     /// per topology step, rounding round and cone-move pass. Returns a
@@ -183,7 +215,7 @@ impl MeshSession {
     pub fn place_cones(
         &self,
         feature_edges: &[u32],
-        alpha_smooth: f64,
+        alpha_smooth: Option<f64>,
         miq: bool,
         progress: &Function,
     ) -> Result<JsValue, JsError> {
@@ -201,7 +233,7 @@ impl MeshSession {
     /// Returns a [`SolveResult`]: the `place_cones` fields plus the map, its
     /// metrics and the exports of the solved mesh. Solve errors throw as
     /// `solve_finish` says.
-    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool, progress: &Function) -> Result<JsValue, JsValue> {
+    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: Option<f64>, miq: bool, progress: &Function) -> Result<JsValue, JsValue> {
         let schedule = self.solve_begin(feature_edges, alpha_smooth, miq)?;
         for c in schedule {
             self.solve_place(c, false, progress)?;
@@ -214,7 +246,8 @@ impl MeshSession {
     /// component (here, or elsewhere and handed over with `solve_add`), then
     /// `solve_finish`. Starts a solve (dropping any unfinished one); returns
     /// the components in the order to place them (largest first).
-    pub fn solve_begin(&mut self, feature_edges: &[u32], alpha_smooth: f64, miq: bool) -> Result<Vec<u32>, JsError> {
+    /// `alpha_smooth` undefined: [`default_alpha`] of `miq`, as the CLI.
+    pub fn solve_begin(&mut self, feature_edges: &[u32], alpha_smooth: Option<f64>, miq: bool) -> Result<Vec<u32>, JsError> {
         self.job = None;
         self.grid = None;
         let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
@@ -260,11 +293,14 @@ impl MeshSession {
         let fail = |e: SolveError| solve_error(&e);
         let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
         let mut report = |p: SolveProgress| {
-            let (stage, a, b) = match p {
+            let (stage, a, b, fraction) = match p {
                 SolveProgress::Cones(c) => cone_stage(&c),
-                SolveProgress::Param(p) => param_stage(&p),
+                SolveProgress::Param(p) => {
+                    let (stage, a, b) = param_stage(&p);
+                    (stage, a, b, None)
+                }
             };
-            notify(progress, stage, a, b);
+            notify(progress, stage, a, b, fraction);
         };
         let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
@@ -286,9 +322,9 @@ impl MeshSession {
         let sol = &grid.solution;
         let quantizer = grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?;
         let map = quantizer
-            .quantize(&sol.mesh, GridSize::Quads(quads as usize), &mut |done, total| notify(progress, "quantization", done, total))
+            .quantize(&sol.mesh, GridSize::Quads(quads as usize), &mut |done, total| notify(progress, "quantization", done, total, None))
             .map_err(|e| JsError::new(&e.to_string()))?;
-        notify(progress, "quad extraction", 0, 0);
+        notify(progress, "quad extraction", 0, 0, None);
         let quad_mesh = extract_quads(&sol.mesh, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
         let sharp: Vec<u32> = sol.features.edges().collect();
         let report = check_quads(&sol.mesh, &quad_mesh, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
@@ -375,9 +411,10 @@ impl MeshSession {
 impl MeshSession {
     /// Checks a cones/solve request: the valid mesh, its features from edge
     /// ids, and the cone options.
-    fn request(&self, feature_edges: &[u32], alpha_smooth: f64, miq: bool) -> Result<(&TriMesh, FeatureSet, ConeOptions), JsError> {
+    fn request(&self, feature_edges: &[u32], alpha_smooth: Option<f64>, miq: bool) -> Result<(&TriMesh, FeatureSet, ConeOptions), JsError> {
         let mesh = self.valid_mesh()?;
         let features = self.features(mesh, feature_edges)?;
+        let alpha_smooth = alpha_smooth.unwrap_or_else(|| default_alpha(miq));
         let (lo, hi) = cones::ALPHA_RANGE;
         if !(lo..=hi).contains(&alpha_smooth) {
             return Err(JsError::new(&format!("alpha_smooth {alpha_smooth} is outside {lo}..{hi}")));
@@ -387,7 +424,7 @@ impl MeshSession {
 
     fn valid_mesh(&self) -> Result<&TriMesh, JsError> {
         self.mesh.as_ref().ok_or_else(|| {
-            let first = self.report.problems.iter().find(|p| p.is_blocking()).map(|p| p.to_string()).unwrap_or_default();
+            let first = self.problems.iter().find(|p| p.blocking).map(|p| p.message.as_str()).unwrap_or_default();
             JsError::new(&format!("this mesh cannot be parametrized: {first}"))
         })
     }
@@ -417,27 +454,35 @@ fn solve_error(e: &SolveError) -> JsValue {
     error.into()
 }
 
-/// Calls the page's `progress(stage, step, remaining)`; a throwing callback
-/// must not stop the solve, so its error is ignored.
-fn notify(progress: &Function, stage: &str, a: usize, b: usize) {
-    let _ = progress.call3(&JsValue::NULL, &stage.into(), &(a as f64).into(), &(b as f64).into());
+/// Calls the page's `progress(stage, step, remaining[, fraction])` (the
+/// fraction of the stage done, where the stage knows it); a throwing
+/// callback must not stop the solve, so its error is ignored.
+fn notify(progress: &Function, stage: &str, a: usize, b: usize, fraction: Option<f64>) {
+    let (stage, a, b) = (JsValue::from(stage), JsValue::from(a as f64), JsValue::from(b as f64));
+    let _ = match fraction {
+        Some(f) => progress.apply(&JsValue::NULL, &Array::of4(&stage, &a, &b, &f.into())),
+        None => progress.call3(&JsValue::NULL, &stage, &a, &b),
+    };
 }
 
 /// Forwards cone-placement progress to the page's `progress`.
 fn cone_progress(progress: &Function) -> impl FnMut(ConeProgress) + '_ {
     move |p| {
-        let (stage, a, b) = cone_stage(&p);
-        notify(progress, stage, a, b);
+        let (stage, a, b, fraction) = cone_stage(&p);
+        notify(progress, stage, a, b, fraction);
     }
 }
 
-/// Stage name and two counters of a cone-placement progress report.
-fn cone_stage(p: &ConeProgress) -> (&'static str, usize, usize) {
+/// Stage name, two counters and the fraction done (where known) of a
+/// cone-placement progress report: cone moves and pair cancellation give the
+/// share of the current pass's candidates evaluated (`remaining`: those left).
+fn cone_stage(p: &ConeProgress) -> (&'static str, usize, usize, Option<f64>) {
+    let share = |done: usize, of: usize| (of > 0).then(|| done as f64 / of as f64);
     match *p {
-        ConeProgress::Topology { component, components } => ("topology", component, components),
-        ConeProgress::Rounding { round, free, .. } => ("rounding", round, free),
-        ConeProgress::ConeMoves { pass, .. } => ("cone moves", pass, 0),
-        ConeProgress::PairCancellation { removed, .. } => ("pair cancellation", removed, 0),
+        ConeProgress::Topology { component, components } => ("topology", component, components, None),
+        ConeProgress::Rounding { round, free, .. } => ("rounding", round, free, None),
+        ConeProgress::ConeMoves { pass, tried, cones, .. } => ("cone moves", pass, cones - tried, share(tried, cones)),
+        ConeProgress::PairCancellation { removed, tried, trials, .. } => ("pair cancellation", removed, trials - tried, share(tried, trials)),
     }
 }
 

@@ -135,18 +135,7 @@ fn get<'a>(m: &'a BTreeMap<String, RawMesh>, name: &str) -> &'a RawMesh {
 fn kinds(r: &MeshReport) -> BTreeMap<&'static str, usize> {
     let mut k = BTreeMap::new();
     for p in &r.problems {
-        let name = match p {
-            Problem::NonManifoldEdge { .. } => "non_manifold_edge",
-            Problem::NonManifoldVertex { .. } => "non_manifold_vertex",
-            Problem::InconsistentOrientation { .. } => "inconsistent_orientation",
-            Problem::ZeroAreaFace { .. } => "zero_area_face",
-            Problem::ZeroLengthEdge { .. } => "zero_length_edge",
-            Problem::DegenerateFace { .. } => "degenerate_face",
-            Problem::DuplicateFace { .. } => "duplicate_face",
-            Problem::UnreferencedVertex { .. } => "unreferenced_vertex",
-            Problem::NonFiniteCoordinate { .. } => "non_finite_coordinate",
-            Problem::IndexOutOfRange { .. } => "index_out_of_range",
-        };
+        let name = p.kind();
         *k.entry(name).or_insert(0) += 1;
     }
     k

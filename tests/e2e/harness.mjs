@@ -31,3 +31,64 @@ export async function closePage(ctx) {
   await ctx?.browser?.close();
   await ctx?.server?.close();
 }
+
+/**
+ * The helpers the tests of one page share: its test hooks, waiting for a load
+ * (after `loads` loads) or a sample, a solve from Run, the next two frames,
+ * and counting the 3D view's pixels whose r, g, b lie in the given ranges.
+ */
+export function pageHelpers(page, { loadTimeout = 90_000, solveTimeout = 120_000 } = {}) {
+  const hooks = () => page.evaluate(() => window.__conemap);
+  const waitForLoad = async (loads) => {
+    await page.waitForFunction((n) => window.__conemap && window.__conemap.loads > n
+      && window.__conemap.state !== 'loading', loads, { timeout: loadTimeout });
+    return hooks();
+  };
+  const nextFrame = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  return {
+    hooks,
+    waitForLoad,
+    nextFrame,
+    async loadSample(file) {
+      const n = (await hooks()).loads;
+      await page.selectOption('[data-testid=samples]', file);
+      const h = await waitForLoad(n);
+      assert.equal(h.state, 'ready', h.lastError ?? '');
+      return h;
+    },
+    async runSolve() {
+      const n = (await hooks()).solves;
+      await page.getByTestId('run').click();
+      await page.waitForFunction((k) => window.__conemap.solves > k, n, { timeout: solveTimeout });
+      return hooks();
+    },
+    async colourPixels([r0, r1], [g0, g1], [b0, b1]) {
+      await nextFrame();
+      return page.evaluate((q) => {
+        const src = document.querySelector('[data-testid=canvas]');
+        const c = document.createElement('canvas');
+        c.width = src.width;
+        c.height = src.height;
+        const g = c.getContext('2d');
+        g.drawImage(src, 0, 0);
+        const d = g.getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          if (d[i] > q[0] && d[i] < q[1] && d[i + 1] > q[2] && d[i + 1] < q[3] && d[i + 2] > q[4] && d[i + 2] < q[5]) n++;
+        }
+        return n;
+      }, [r0, r1, g0, g1, b0, b1]);
+    },
+  };
+}
+
+/** `openPage`, then the site at 1400×900 with its first mesh ready: the context and `pageHelpers` of its page. */
+export async function openReadyPage() {
+  const ctx = await openPage();
+  const helpers = pageHelpers(ctx.page);
+  await ctx.page.setViewportSize({ width: 1400, height: 900 });
+  await ctx.page.goto(ctx.server.url);
+  const h = await helpers.waitForLoad(0);
+  assert.equal(h.state, 'ready', h.lastError ?? '');
+  return { ctx, ...helpers };
+}

@@ -114,6 +114,40 @@ describe('conemap page', () => {
     await screenshot('sample-beetle-problems');
   });
 
+  it('numbers beetle\'s problems as the file does and frames the one clicked', async () => {
+    // The file's `f` statements (1-based) with their `v` numbers (1-based, positive in beetle.obj).
+    const text = fs.readFileSync(path.join(root, '../shared/meshes/beetle.obj'), 'utf8');
+    const faces = text.split('\n').filter((l) => /^f\s/.test(l)).map((l) => l.trim().split(/\s+/).slice(1).map((c) => Number(c.split('/')[0])));
+    const lines = page.getByTestId('problem-line');
+    const messages = await lines.allInnerTexts();
+    const nonManifold = messages.map((m, i) => ({ m, i, parts: m.match(/^edge \(v(\d+), v(\d+)\) has (\d+) faces \((.*)\)$/) })).filter((x) => x.parts);
+    assert.ok(nonManifold.length > 0, `no non-manifold edge among ${JSON.stringify(messages.slice(0, 3))}`);
+    for (const { parts } of nonManifold.slice(0, 10)) {
+      const [a, b] = [Number(parts[1]), Number(parts[2])];
+      const named = parts[4].split(', ').map((f) => Number(f.replace(/^f/, '')));
+      assert.equal(named.length, Number(parts[3]));
+      for (const f of named) {
+        const corners = faces[f - 1];
+        assert.ok(corners, `f${f} is not a face of the file`);
+        assert.ok(corners.includes(a) && corners.includes(b), `f${f} (${corners}) of the file does not join v${a} and v${b}`);
+      }
+    }
+    // A click on a line frames its edge: the camera then looks at the edge's end points.
+    const { i } = nonManifold[nonManifold.length - 1];
+    const before = await page.evaluate(() => window.__conemapTest.cameraTarget());
+    await lines.nth(i).click();
+    const h = await page.evaluate(() => window.__conemap);
+    assert.equal(h.problemFocus.index, i);
+    const target = await page.evaluate(() => window.__conemapTest.cameraTarget());
+    const ends = await page.evaluate((vs) => vs.map((v) => window.__conemapTest.vertexPosition(v)), h.problemFocus.vertices);
+    const mid = [0, 1, 2].map((k) => ends.reduce((s, p) => s + p[k], 0) / ends.length);
+    const radius = Math.max(...ends.map((p) => Math.hypot(p[0] - mid[0], p[1] - mid[1], p[2] - mid[2])));
+    assert.ok(Math.hypot(target[0] - mid[0], target[1] - mid[1], target[2] - mid[2]) <= radius + 1e-6, `camera looks at ${target}, not at the problem around ${mid}`);
+    assert.ok(Math.hypot(target[0] - before[0], target[1] - before[1], target[2] - before[2]) > 0, 'the camera did not move');
+    assert.match(await lines.nth(i).getAttribute('class'), /selected/);
+    await screenshot('sample-beetle-problem-framed');
+  });
+
   it('shows a readable error for a corrupt file and keeps the previous mesh', async () => {
     const before = await page.evaluate(() => window.__conemap.stats);
     const n = await loads();

@@ -102,12 +102,12 @@ describe('feature editing and solving', () => {
     const pts = await page.evaluate(() => {
       const t = window.__conemapTest;
       const rect = document.querySelector('[data-testid=canvas]').getBoundingClientRect();
-      // Two points on the mesh, well apart: scan a grid for positions that hit an edge.
+      // Two points on the mesh, well apart: scan a grid for positions that hit it.
       const hits = [];
       for (let i = 1; i < 8 && hits.length < 2; i++) {
         const x = rect.left + rect.width * (0.3 + 0.06 * i);
         const y = rect.top + rect.height * (0.35 + 0.04 * i);
-        if (t.edgeAt(x, y) >= 0 && (hits.length === 0 || Math.hypot(x - hits[0].x, y - hits[0].y) > 120)) hits.push({ x, y });
+        if (t.pick(x, y) && (hits.length === 0 || Math.hypot(x - hits[0].x, y - hits[0].y) > 120)) hits.push({ x, y });
       }
       return hits;
     });
@@ -307,19 +307,21 @@ describe('feature editing and solving', () => {
     await screenshot(`solved-${big.replace(/\.obj$/, '')}`);
   });
 
-  it('shows solver errors next to Run and stays usable', async () => {
+  it('turns Run off, saying why, on a mesh that cannot be solved, and on again for the next', async () => {
     const options = await sampleOptions();
     assert.ok(options.includes('beetle.obj'), 'beetle.obj not among the samples');
     await loadSample('beetle.obj');
-    const h = await runSolve();
-    assert.equal(h.state, 'ready');
-    assert.match(h.solveError, /cannot be parametrized/);
-    const error = page.getByTestId('solve-error');
-    assert.ok(await error.isVisible());
-    assert.match(await error.innerText(), /cannot be parametrized/);
-    await screenshot('solve-error-beetle');
+    const run = page.getByTestId('run');
+    assert.equal(await run.isEnabled(), false, 'Run is off on a non-manifold mesh');
+    const note = page.getByTestId('solve-note');
+    assert.ok(await note.isVisible());
+    assert.match(await note.innerText(), /^Run is off: this mesh cannot be parametrized \(\d+ edges with more than two faces/);
+    assert.equal(await run.getAttribute('title'), await note.innerText(), 'the reason is the button\'s tooltip too');
+    assert.equal(await run.getAttribute('aria-describedby'), 'solve-note');
+    await screenshot('solve-blocked-beetle');
     await loadSample('fandisk.obj');
-    assert.equal(await error.isVisible(), false);
+    assert.equal(await run.isEnabled(), true);
+    assert.equal(await note.isVisible(), false);
   });
 
   it('leaves the boundary free with the toggle: woody (flat) gets no corners and no cones', async () => {

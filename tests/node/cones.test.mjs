@@ -18,11 +18,19 @@ test('fandisk with sharp features: Gauss-Bonnet, progress by round, exact constr
   assert.ok(sharp.length > 0 && sharp.length < edges.length / 2);
   const stages = new Set();
   let roundingCalls = 0;
-  const r = session.place_cones(sharp, 0.01, false, (stage) => {
+  const fractions = [];
+  const r = session.place_cones(sharp, 0.01, false, (stage, step, remaining, fraction) => {
     stages.add(stage);
     if (stage === 'rounding') roundingCalls += 1;
+    if (fraction !== undefined) fractions.push([stage, fraction]);
   });
   for (const stage of ['topology', 'rounding', 'cone moves']) assert.ok(stages.has(stage), `no ${stage} report`);
+  // Cone moves and pair cancellation tell the share of their pass done.
+  assert.ok(fractions.some(([stage]) => stage === 'cone moves'), 'cone moves report no fraction');
+  for (const [stage, f] of fractions) {
+    assert.ok(['cone moves', 'pair cancellation'].includes(stage), `a fraction for ${stage}`);
+    assert.ok(f >= 0 && f < 1, `${stage}: fraction ${f}`);
+  }
   assert.equal(r.feature_edges, sharp.length);
   assert.equal(sumK(r), 4 * 2, 'sum of k = 4 chi');
   for (const c of r.components) {
@@ -42,10 +50,17 @@ test('woody (open surface): boundary corners and cones add up to 4 chi', () => {
   assert.ok(r.boundary_corners.length > 0);
 });
 
-test('MIQ emulation runs on the same mesh', () => {
+test('MIQ emulation runs on the same mesh; without an α it takes the CLI\'s --miq default', () => {
+  assert.equal(wasm.default_alpha(false), 0.01);
+  assert.equal(wasm.default_alpha(true), 100);
   const session = open(committedFandisk);
-  const r = session.place_cones(session.sharp_edges(60), 100, true, () => {});
+  const sharp = session.sharp_edges(60);
+  const r = session.place_cones(sharp, 100, true, () => {});
   assert.equal(sumK(r), 8);
+  const byDefault = session.place_cones(sharp, undefined, true, () => {});
+  assert.equal(byDefault.energy, r.energy, 'undefined α with MIQ is α = 100');
+  const plain = session.place_cones(sharp, undefined, false, () => {});
+  assert.equal(plain.energy, session.place_cones(sharp, 0.01, false, () => {}).energy, 'undefined α without MIQ is 0.01');
 });
 
 test('bad requests give readable errors, not crashes', () => {

@@ -140,3 +140,58 @@ describe('glTF fixtures match their OBJ', () => {
     });
   }
 });
+
+describe('problems located and numbered as the file does', () => {
+  const open = (name, text) => wasm.MeshSession.open([{ name, bytes: new TextEncoder().encode(text) }]);
+
+  it('names beetle\'s non-manifold edges by the OBJ file\'s 1-based v and f numbers', () => {
+    const file = sharedMesh('beetle');
+    const text = fs.readFileSync(file, 'utf8');
+    const faces = text.split('\n').filter((l) => /^f\s/.test(l)).map((l) => l.trim().split(/\s+/).slice(1).map((c) => Number(c.split('/')[0])));
+    const session = wasm.MeshSession.open([{ name: 'beetle.obj', bytes: new Uint8Array(fs.readFileSync(file)) }]);
+    const report = session.report();
+    const located = report.located_problems;
+    assert.equal(located.length, report.problems.length);
+    assert.deepEqual(located.map((p) => p.message), report.problem_messages);
+    assert.deepEqual(located.map((p) => p.kind), report.problems.map((p) => p.kind));
+    const positions = session.positions();
+    const edges = located.filter((p) => p.kind === 'non_manifold_edge');
+    assert.ok(edges.length > 0);
+    for (const p of edges) {
+      assert.equal(p.blocking, true);
+      const [, a, b, list] = p.message.match(/^edge \(v(\d+), v(\d+)\) has \d+ faces \((.*)\)$/);
+      for (const f of list.split(', ').map((x) => Number(x.slice(1)))) {
+        assert.ok(faces[f - 1].includes(Number(a)) && faces[f - 1].includes(Number(b)), `${p.message}: f${f} is ${faces[f - 1]}`);
+      }
+      // Located in the shown mesh's ids: the edge's ends are the pair drawn, the faces are triangles.
+      assert.deepEqual(p.vertices, p.edges);
+      assert.equal(p.edges.length, 2);
+      for (const v of p.vertices) assert.ok(v < positions.length / 3);
+      assert.equal(p.faces.length, list.split(', ').length);
+    }
+    assert.throws(() => session.place_cones(new Uint32Array(), 0.01, false, () => {}), new RegExp(`cannot be parametrized: ${edges[0].message.replace(/[()]/g, '\\$&')}`));
+  });
+
+  it('numbers the faces of polygons by their f statement', () => {
+    // Three quads around one edge (v1, v2): each fan-triangulated into two triangles.
+    const obj = 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 -1 0\nv 1 -1 0\nv 0 0 1\nv 1 0 1\n'
+      + 'f 1 2 4 3\nf 2 1 5 6\nf 1 2 8 7\n';
+    const p = open('quads.obj', obj).report().located_problems.find((x) => x.kind === 'non_manifold_edge');
+    assert.equal(p.message, 'edge (v1, v2) has 3 faces (f1, f2, f3)');
+  });
+
+  it('says what a features file lacks, and which edge does not match the mesh', () => {
+    const session = wasm.MeshSession.open([{ name: 'fandisk.obj', bytes: new Uint8Array(fs.readFileSync(committedFandisk)) }]);
+    const sharp = session.sharp_edges(60);
+    const positions = session.positions();
+    const edges = session.edges();
+    const at = (v) => Array.from(positions.subarray(3 * v, 3 * v + 3));
+    const ends = Array.from(sharp, (e) => [at(edges[2 * e]), at(edges[2 * e + 1])]);
+    assert.deepEqual([...session.features_from_json(JSON.stringify({ edges: ends }))], [...sharp], 'the CLI form');
+    const report = { features: { edges: Array.from(sharp), positions: ends, boundary_edges: 0 } };
+    assert.deepEqual([...session.features_from_json(JSON.stringify(report))], [...sharp], 'a JSON report');
+    assert.throws(() => session.features_from_json('{"edges": [[[9, 9, 9], [1, 0, 0]]]}'), /feature edge 0: no mesh vertex at \(9, 9, 9\): the file does not match this mesh/);
+    assert.throws(() => session.features_from_json('hello'), /not a JSON file/);
+    assert.throws(() => session.features_from_json('{"faces": []}'), /expected \{"edges"/);
+  });
+});

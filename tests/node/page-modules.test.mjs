@@ -126,6 +126,43 @@ describe('features.ts', () => {
     assert.ok(f.undo());
     assert.deepEqual([...f.ids()], [2, 4, 5]);
   });
+
+  it('undoes the sharp settings with the edges, and a slider drag as one step', () => {
+    const f = new FeatureSet(8, Uint32Array.from([0]));
+    const at = (degrees) => ({ degrees, minEdges: 0, closedOnly: false });
+    assert.ok(f.setSharp(Uint32Array.from([3]), at(90)));
+    // A drag from 90° to 30° in three moves, released: one change.
+    assert.ok(f.setSharp(Uint32Array.from([3, 4]), at(60), true));
+    assert.ok(f.setSharp(Uint32Array.from([3, 4, 5]), at(45), true));
+    assert.ok(f.setSharp(Uint32Array.from([3, 5, 6]), at(30), true));
+    f.closeChange();
+    assert.deepEqual([...f.ids()], [3, 5, 6]);
+    assert.deepEqual(f.sharpSettings, at(30));
+    assert.ok(f.undo());
+    assert.deepEqual([...f.ids()], [3], 'one undo takes back the whole drag');
+    assert.deepEqual(f.sharpSettings, at(90));
+    assert.ok(f.undo());
+    assert.deepEqual([...f.ids()], []);
+    assert.equal(f.sharpSettings, null, 'undoing everything turns the detection off');
+    assert.ok(f.redo() && f.redo());
+    assert.deepEqual([...f.ids()], [3, 5, 6]);
+    assert.deepEqual(f.sharpSettings, at(30));
+    // A later change after the release is a step of its own; the sharp edges move with undo.
+    assert.ok(f.setSharp(Uint32Array.from([7]), at(20), true));
+    assert.ok(f.undo());
+    assert.deepEqual([...f.ids()], [3, 5, 6]);
+    assert.ok(f.setSharp(null, null));
+    assert.deepEqual([...f.ids()], [], 'the restored sharp edges are the ones replaced');
+  });
+
+  it('replaces every mark by an imported list', () => {
+    const f = new FeatureSet(6, Uint32Array.from([0]));
+    f.toggle(1);
+    assert.ok(f.replaceAll(Uint32Array.from([0, 2, 3])));
+    assert.deepEqual([...f.ids()], [2, 3]);
+    assert.ok(f.undo());
+    assert.deepEqual([...f.ids()], [1]);
+  });
 });
 
 describe('solve-view.ts', () => {

@@ -1,5 +1,6 @@
 // Element lookup, definition tables and the number / size / time formatting the
 // page's panels share. No state; the formatters are pure.
+import { GLOSSARY } from './glossary';
 
 /** The element of index.html with id `id` (as `T`); throws when the page lacks it. */
 export const $ = <T extends HTMLElement = HTMLElement>(id: string): T => {
@@ -22,12 +23,17 @@ export const fmtBytes = (n: number): string =>
 /** A duration in milliseconds, rounded: "12 ms". */
 export const fmtMs = (ms: number): string => `${ms.toFixed(0)} ms`;
 
-/** A two-column table of figures; each value carries `data-stat` (its key in kebab case). */
+/** A two-column table of figures; each value carries `data-stat` (its key in kebab case), each jargon label its plain words as tooltip. */
 export function definitionList(rows: Array<[string, string]>): HTMLDListElement {
   const table = document.createElement('dl');
   for (const [k, v] of rows) {
     const dt = document.createElement('dt');
     dt.textContent = k;
+    const tip = GLOSSARY[k];
+    if (tip) {
+      dt.title = tip;
+      dt.className = 'term';
+    }
     const dd = document.createElement('dd');
     dd.textContent = v;
     dd.dataset['stat'] = statKey(k);

@@ -1,7 +1,8 @@
-// The solve side of the page put together: the feature editor, the solve
-// controller, the result panel and its quads, told of a new mesh and of each
-// other's news.
+// The solve side of the page put together: the mesh's problems, the feature
+// editor, the solve controller, the result panel and its quads, told of a new
+// mesh and of each other's news.
 import { FeatureEditor } from './feature-editor';
+import { MeshProblems } from './mesh-problems';
 import type { ImportResult } from './protocol';
 import { QuadPanel } from './quad-panel';
 import { ResultPanel } from './result-panel';
@@ -12,13 +13,15 @@ import type { Viewer } from './viewer';
 import type { MeshWorker } from './worker-client';
 
 export class Editor {
+  readonly problems: MeshProblems;
   readonly features: FeatureEditor;
   readonly results: ResultPanel;
   readonly quads: QuadPanel;
   readonly solve: SolveController;
 
-  /** Wires the four parts to `viewer`, `worker`, the page's `store` and the test `hooks` they keep up to date. */
+  /** Wires the five parts to `viewer`, `worker`, the page's `store` and the test `hooks` they keep up to date. */
   constructor(viewer: Viewer, worker: MeshWorker, store: PageStore, hooks: Hooks) {
+    this.problems = new MeshProblems(viewer, hooks);
     this.features = new FeatureEditor(viewer, worker, hooks, {
       onChange: () => this.solve.featuresChanged(),
       onError: (message) => this.solve.showError(message),
@@ -29,12 +32,13 @@ export class Editor {
       onGridUv: (uv) => this.results.showGridUv(uv),
     });
     this.results = new ResultPanel(viewer, hooks, this.quads);
-    this.solve = new SolveController(viewer, worker, store, this.features, this.results, hooks);
+    this.solve = new SolveController(viewer, worker, store, this.features, this.problems, this.results, hooks);
   }
 
-  /** Opens a freshly imported mesh (`data`, shown by the viewer, named `label`): no features, no result, no solve error. */
+  /** Opens a freshly imported mesh (`data`, shown by the viewer, named `label`): its problems listed and drawn, no features, no result, no solve error. */
   setMesh(data: ImportResult, label: string): void {
     this.results.clear();
+    this.problems.show(data);
     this.features.setMesh(data, label);
     this.solve.meshChanged();
   }

@@ -1,10 +1,14 @@
-// Feature editing on the open mesh: click an edge to toggle it, Shift-click two
-// vertices to mark the shortest path between them, the sharp-edge detection
-// controls, undo / redo / clear (buttons and keys); and the queries of the open
-// mesh's geometry the test hooks answer with.
+// Feature editing on the open mesh: the edge under the pointer highlighted and
+// a click toggling it, Shift-click two vertices to mark the shortest path
+// between them, the sharp-edge detection controls (a slider drag is one undo
+// step), undo / redo / clear (buttons and keys, the detection settings with
+// the edges), features import and export as JSON; and the queries of the
+// open mesh's geometry the test hooks answer with.
 import { $, fmtInt } from './dom';
-import { FeatureSet } from './features';
+import { download, fileStem } from './downloads';
+import { FeatureSet, type SharpSettings } from './features';
 import { COLORS } from './palette';
+import { latestPerFrame } from './render-loop';
 import type { ImportResult } from './protocol';
 import type { Hooks } from './test-hooks';
 import { type Adjacency, shortestPath } from './topology';
@@ -30,12 +34,17 @@ export interface FeatureEvents {
 
 const NO_EDGE = 0xffffffff;
 /** A click further than this from every side of the hit triangle toggles nothing (CSS px). */
-const PICK_TOLERANCE = 24;
+const PICK_TOLERANCE = 6;
+const HINT = 'Click an edge to toggle it; Shift-click two vertices to mark the shortest path between them.';
 
 export class FeatureEditor {
   private open: OpenMesh | null = null;
   /** First vertex of a Shift-click path, until the second. */
   private anchor: number | null = null;
+  /** The edge highlighted under the pointer (-1: none). */
+  private hovered = -1;
+  /** Sharp-edge requests run one after the other, in order. */
+  private sharpQueue: Promise<void> = Promise.resolve();
   private readonly el = {
     count: $('feature-count'),
     boundaryCount: $('boundary-count'),
@@ -45,6 +54,9 @@ export class FeatureEditor {
     sharpMinEdges: $<HTMLInputElement>('sharp-min-edges'),
     sharpClosed: $<HTMLInputElement>('sharp-closed'),
     sharpStats: $<HTMLElement>('sharp-stats'),
+    hint: $<HTMLElement>('feature-hint'),
+    importInput: $<HTMLInputElement>('features-file'),
+    exportButton: $<HTMLButtonElement>('export-features'),
     undo: $<HTMLButtonElement>('undo-button'),
     redo: $<HTMLButtonElement>('redo-button'),
     clear: $<HTMLButtonElement>('clear-features'),
@@ -53,7 +65,7 @@ export class FeatureEditor {
   constructor(
     private readonly viewer: Viewer,
     private readonly worker: MeshWorker,
-    private readonly hooks: Pick<Hooks, 'features'>,
+    private readonly hooks: Pick<Hooks, 'features' | 'hoverEdge'>,
     private readonly events: FeatureEvents,
   ) {
     this.wirePicking();
@@ -71,11 +83,9 @@ export class FeatureEditor {
     const edges = data.edges ?? new Uint32Array(0);
     const features = data.valid && data.edges ? new FeatureSet(edges.length / 2, data.boundary) : null;
     this.open = { label, data, edges, features, adjacency: data.adjacency };
-    this.anchor = null;
-    this.el.sharpToggle.checked = false;
-    this.el.sharpAngle.disabled = true;
-    this.el.sharpMinEdges.disabled = true;
-    this.el.sharpClosed.disabled = true;
+    this.setAnchor(null);
+    this.hover(-1);
+    this.showSharpSettings(null);
     this.el.sharpStats.textContent = '';
     if (features) this.viewer.setLines('boundary', edges, data.boundary, COLORS.boundary, 3, 0);
     this.redraw();
@@ -84,6 +94,33 @@ export class FeatureEditor {
   /** The sharp-edge threshold in use (degrees), or null when detection is off. */
   sharpThreshold(): number | null {
     return this.el.sharpToggle.checked ? Number(this.el.sharpAngle.value) : null;
+  }
+
+  /** Shows detection `settings` in the controls (null: off, the other controls disabled). */
+  private showSharpSettings(settings: SharpSettings | null): void {
+    const el = this.el;
+    el.sharpToggle.checked = settings !== null;
+    if (settings) {
+      el.sharpAngle.value = String(settings.degrees);
+      el.sharpMinEdges.value = String(settings.minEdges);
+      el.sharpClosed.checked = settings.closedOnly;
+    }
+    this.showAngle();
+    for (const c of [el.sharpAngle, el.sharpMinEdges, el.sharpClosed]) c.disabled = settings === null;
+  }
+
+  /** The angle beside the slider, and the slider's spoken value. */
+  private showAngle(): void {
+    this.el.sharpValue.textContent = `${this.el.sharpAngle.value}°`;
+    this.el.sharpAngle.setAttribute('aria-valuetext', `${this.el.sharpAngle.value} degrees`);
+  }
+
+  /** The detection settings the controls show (null: detection off). */
+  private controlSettings(): SharpSettings | null {
+    const el = this.el;
+    if (!el.sharpToggle.checked) return null;
+    const minEdges = Math.max(0, Math.floor(Number(el.sharpMinEdges.value) || 0));
+    return { degrees: Number(el.sharpAngle.value), minEdges, closedOnly: el.sharpClosed.checked };
   }
 
   private redraw(): void {
@@ -104,12 +141,43 @@ export class FeatureEditor {
     this.el.redo.disabled = !f?.canRedo;
     this.el.clear.disabled = !f || n === 0;
     this.el.sharpToggle.disabled = !f;
+    this.el.exportButton.disabled = !f || n === 0;
+    const importLabel = this.el.importInput.labels?.[0];
+    this.el.importInput.disabled = !f;
+    importLabel?.classList.toggle('disabled', !f);
   }
 
   private changed(did: boolean): void {
     if (!did) return;
     this.redraw();
     this.events.onChange();
+  }
+
+  /** After an undo or redo (`did`): the edges, and the detection controls as the change left them (the counts only while they still hold). */
+  private stepped(did: boolean): void {
+    if (!did) return;
+    const settings = this.open?.features?.sharpSettings ?? null;
+    if (JSON.stringify(settings) !== JSON.stringify(this.controlSettings())) this.el.sharpStats.textContent = '';
+    this.showSharpSettings(settings);
+    this.changed(true);
+  }
+
+  /** The first vertex of a Shift-click path (null: none), its marker and the hint saying what comes next. */
+  private setAnchor(vertex: number | null): void {
+    this.anchor = vertex;
+    this.viewer.setAnchor(vertex);
+    this.el.hint.textContent = vertex === null ? HINT : 'Shift-click the second vertex to mark the path; Esc cancels.';
+    this.el.hint.classList.toggle('active', vertex !== null);
+  }
+
+  /** Highlights edge `e` under the pointer (-1: none). */
+  private hover(e: number): void {
+    if (e === this.hovered) return;
+    this.hovered = e;
+    this.hooks.hoverEdge = e >= 0 ? e : null;
+    const m = this.open;
+    this.viewer.setLines('hover-edge', m?.edges ?? new Uint32Array(0), e >= 0 ? [e] : [], COLORS.hover, 6, 3);
+    this.viewer.canvas.style.cursor = e >= 0 ? 'pointer' : '';
   }
 
   private edgeFromPick(x: number, y: number): number {
@@ -128,13 +196,11 @@ export class FeatureEditor {
       const pick = this.viewer.pick(x, y);
       if (!pick) return;
       if (this.anchor === null) {
-        this.anchor = pick.vertex;
-        this.viewer.setAnchor(pick.vertex);
+        this.setAnchor(pick.vertex);
         return;
       }
       const path = m.adjacency ? shortestPath(m.adjacency, m.data.positions, this.anchor, pick.vertex) : null;
-      this.anchor = null;
-      this.viewer.setAnchor(null);
+      this.setAnchor(null);
       if (path) this.changed(m.features.addAll(path));
       return;
     }
@@ -145,6 +211,9 @@ export class FeatureEditor {
   private wirePicking(): void {
     const canvas = this.viewer.canvas;
     let down: { x: number; y: number; t: number } | null = null;
+    const hoverAt = latestPerFrame((e: PointerEvent) => this.hover(e.buttons === 0 && !e.shiftKey ? this.edgeFromPick(e.clientX, e.clientY) : -1));
+    canvas.addEventListener('pointermove', hoverAt);
+    canvas.addEventListener('pointerleave', () => requestAnimationFrame(() => this.hover(-1)));
     canvas.addEventListener('pointerdown', (e) => {
       down = e.button === 0 ? { x: e.clientX, y: e.clientY, t: performance.now() } : null;
     });
@@ -157,62 +226,108 @@ export class FeatureEditor {
     });
   }
 
-  private async applySharp(): Promise<void> {
-    const f = this.open?.features;
-    if (!f) return;
+  /**
+   * Queues a detection with the settings the controls show when its turn
+   * comes (the detection of an unchanged setting is skipped); `drag`: part
+   * of a slider drag (one undo step with the rest of it), `release` ends it.
+   */
+  private requestSharp(drag: boolean, release = false): void {
+    this.sharpQueue = this.sharpQueue.then(async () => {
+      await this.applySharp(drag);
+      if (release) this.open?.features?.closeChange();
+    });
+  }
+
+  /** Runs the detection the controls ask for on the open mesh and marks its edges (see `requestSharp`). */
+  private async applySharp(drag: boolean): Promise<void> {
     const mesh = this.open;
-    const deg = Number(this.el.sharpAngle.value);
-    if (!this.el.sharpToggle.checked) {
+    const f = mesh?.features;
+    if (!f) return;
+    const settings = this.controlSettings();
+    if (JSON.stringify(settings) === JSON.stringify(f.sharpSettings)) return;
+    if (!settings) {
       this.el.sharpStats.textContent = '';
-      this.changed(f.setSharp(null));
+      this.changed(f.setSharp(null, null));
       return;
     }
-    const minEdges = Math.max(0, Math.floor(Number(this.el.sharpMinEdges.value) || 0));
-    const closedOnly = this.el.sharpClosed.checked;
     try {
-      const { edges, stats } = await this.worker.sharpEdges(deg, minEdges, closedOnly);
-      if (this.open !== mesh || !this.el.sharpToggle.checked || Number(this.el.sharpAngle.value) !== deg) return;
+      const { edges, stats } = await this.worker.sharpEdges(settings.degrees, settings.minEdges, settings.closedOnly);
+      if (this.open !== mesh) return;
       const n = (k: number, one: string, many: string) => `${k} ${k === 1 ? one : many}`;
       const pruned = stats.pruned_edges ? `, ${n(stats.pruned_edges, 'dangling edge', 'dangling edges')}` : '';
       this.el.sharpStats.textContent = `${n(stats.sharp_edges, 'sharp edge', 'sharp edges')}: ${n(stats.curves, 'curve', 'curves')} (${n(stats.kept_edges, 'edge', 'edges')}) kept, ${n(stats.dropped_fragments, 'fragment', 'fragments')}${pruned} dropped`;
-      this.changed(f.setSharp(edges));
+      this.changed(f.setSharp(edges, settings, drag));
     } catch (e) {
       if (!(e instanceof Cancelled)) this.events.onError(`sharp edges: ${e instanceof Error ? e.message : String(e)}`);
     }
   }
 
+  /** Reads a features file or JSON report and marks the edges it names instead of the current ones (one undo step). */
+  private async importFeatures(file: File): Promise<void> {
+    const mesh = this.open;
+    const f = mesh?.features;
+    if (!f) return;
+    try {
+      const ids = await this.worker.featuresFromJson(await file.text());
+      if (this.open !== mesh) return;
+      this.showSharpSettings(null);
+      this.changed(f.replaceAll(ids));
+      this.el.sharpStats.textContent = `Imported ${fmtInt(ids.length)} feature ${ids.length === 1 ? 'edge' : 'edges'} from ${file.name}.`;
+    } catch (e) {
+      if (!(e instanceof Cancelled)) this.events.onError(`Could not import features from ${file.name}: ${e instanceof Error ? e.message : String(e)}`);
+    }
+  }
+
+  /** Saves the marked edges as `{edges: [[[x, y, z], [x, y, z]], …]}`, the form `conemap solve --features` reads. */
+  private exportFeatures(): void {
+    const m = this.open;
+    if (!m?.features) return;
+    const p = m.data.positions;
+    const at = (v: number): number[] => Array.from(p.subarray(3 * v, 3 * v + 3));
+    const edges = Array.from(m.features.ids(), (e) => [at(m.edges[2 * e]!), at(m.edges[2 * e + 1]!)]);
+    download(new Blob([JSON.stringify({ file: m.label, edges })], { type: 'application/json' }), `${fileStem(m.label)}-features.json`);
+  }
+
   private wireControls(): void {
     const el = this.el;
     el.sharpToggle.addEventListener('change', () => {
-      el.sharpAngle.disabled = !el.sharpToggle.checked;
-      el.sharpMinEdges.disabled = !el.sharpToggle.checked;
-      el.sharpClosed.disabled = !el.sharpToggle.checked;
-      void this.applySharp();
+      for (const c of [el.sharpAngle, el.sharpMinEdges, el.sharpClosed]) c.disabled = !el.sharpToggle.checked;
+      this.requestSharp(false);
     });
-    el.sharpAngle.addEventListener('input', () => (el.sharpValue.textContent = `${el.sharpAngle.value}°`));
-    el.sharpAngle.addEventListener('change', () => void this.applySharp());
-    el.sharpMinEdges.addEventListener('change', () => void this.applySharp());
-    el.sharpClosed.addEventListener('change', () => void this.applySharp());
-    el.undo.addEventListener('click', () => this.changed(this.open?.features?.undo() ?? false));
-    el.redo.addEventListener('click', () => this.changed(this.open?.features?.redo() ?? false));
+    // Dragging the slider updates the marks as it goes: one undo step, ended on release.
+    el.sharpAngle.addEventListener('input', () => {
+      this.showAngle();
+      this.requestSharp(true);
+    });
+    el.sharpAngle.addEventListener('change', () => this.requestSharp(true, true));
+    el.sharpMinEdges.addEventListener('change', () => this.requestSharp(false));
+    el.sharpClosed.addEventListener('change', () => this.requestSharp(false));
+    el.undo.addEventListener('click', () => this.stepped(this.open?.features?.undo() ?? false));
+    el.redo.addEventListener('click', () => this.stepped(this.open?.features?.redo() ?? false));
     el.clear.addEventListener('click', () => {
-      el.sharpToggle.checked = false;
-      el.sharpAngle.disabled = true;
-      this.changed(this.open?.features?.clear() ?? false);
+      const did = this.open?.features?.clear() ?? false;
+      this.showSharpSettings(null);
+      this.el.sharpStats.textContent = '';
+      this.changed(did);
     });
+    el.importInput.addEventListener('change', () => {
+      const file = el.importInput.files?.[0];
+      el.importInput.value = ''; // choosing the same file again still fires `change`
+      if (file) void this.importFeatures(file);
+    });
+    el.exportButton.addEventListener('click', () => this.exportFeatures());
     window.addEventListener('keydown', (e) => {
       const target = e.target as HTMLElement | null;
       if (target && (target.tagName === 'INPUT' && (target as HTMLInputElement).type === 'text')) return;
       const key = e.key.toLowerCase();
       if ((e.ctrlKey || e.metaKey) && key === 'z') {
         e.preventDefault();
-        this.changed((e.shiftKey ? this.open?.features?.redo() : this.open?.features?.undo()) ?? false);
+        this.stepped((e.shiftKey ? this.open?.features?.redo() : this.open?.features?.undo()) ?? false);
       } else if ((e.ctrlKey || e.metaKey) && key === 'y') {
         e.preventDefault();
-        this.changed(this.open?.features?.redo() ?? false);
+        this.stepped(this.open?.features?.redo() ?? false);
       } else if (key === 'escape' && this.anchor !== null) {
-        this.anchor = null;
-        this.viewer.setAnchor(null);
+        this.setAnchor(null);
       }
     });
   }

@@ -1,13 +1,33 @@
 // Feature edges chosen by the user: one flag per edge, boundary edges fixed,
-// undo/redo of every change (a change is the list of edges whose flag flipped).
+// undo/redo of every change (a change is the list of edges whose flag flipped,
+// with the sharp-edge detection settings before and after it).
+
+/** The sharp-edge detection settings a change was made with (null: detection off). */
+export interface SharpSettings {
+  degrees: number;
+  minEdges: number;
+  closedOnly: boolean;
+}
+
+/** One undoable change: the edges flipped, the sharp edges and settings before and after; `open` while a slider drag may extend it. */
+interface Change {
+  edges: Uint32Array;
+  sharpBefore: Uint8Array;
+  sharpAfter: Uint8Array;
+  settingsBefore: SharpSettings | null;
+  settingsAfter: SharpSettings | null;
+  open: boolean;
+}
 
 export class FeatureSet {
   readonly flags: Uint8Array;
   readonly boundary: Uint8Array;
   /** Edges set by the last sharp-edge threshold (replaced when it changes). */
   private sharp: Uint8Array;
-  private undoStack: Uint32Array[] = [];
-  private redoStack: Uint32Array[] = [];
+  /** The detection settings of the current marks (restored by undo and redo). */
+  private settings: SharpSettings | null = null;
+  private undoStack: Change[] = [];
+  private redoStack: Change[] = [];
   private n = 0;
   readonly boundaryCount: number;
 
@@ -36,6 +56,11 @@ export class FeatureSet {
     return this.flags[e] === 1;
   }
 
+  /** The sharp-edge detection settings of the current marks (null: off). */
+  get sharpSettings(): SharpSettings | null {
+    return this.settings;
+  }
+
   private flip(edges: Uint32Array): void {
     for (const e of edges) {
       this.flags[e] ^= 1;
@@ -43,14 +68,38 @@ export class FeatureSet {
     }
   }
 
-  /** Applies a change (edges to flip); returns false when it changes nothing. */
-  private commit(edges: number[]): boolean {
-    if (edges.length === 0) return false;
-    const change = Uint32Array.from(edges);
-    this.flip(change);
-    this.undoStack.push(change);
-    this.redoStack = [];
+  /**
+   * Applies a change (edges to flip, the sharp edges and settings after it);
+   * with `extend`, merges it into the last change while that one is open (a
+   * slider drag). Returns false when it changes nothing.
+   */
+  private commit(edges: number[], sharpAfter = this.sharp, settingsAfter = this.settings, extend = false): boolean {
+    const sameSettings = JSON.stringify(settingsAfter) === JSON.stringify(this.settings);
+    if (edges.length === 0 && sameSettings) return false;
+    const flipped = Uint32Array.from(edges);
+    this.flip(flipped);
+    const last = this.undoStack[this.undoStack.length - 1];
+    if (extend && last?.open && this.redoStack.length === 0) {
+      // Edges flipped twice over the drag cancel out.
+      const odd = new Set<number>(last.edges);
+      for (const e of flipped) if (!odd.delete(e)) odd.add(e);
+      last.edges = Uint32Array.from(odd);
+      last.sharpAfter = sharpAfter;
+      last.settingsAfter = settingsAfter;
+    } else {
+      this.closeChange();
+      this.undoStack.push({ edges: flipped, sharpBefore: this.sharp, sharpAfter, settingsBefore: this.settings, settingsAfter, open: extend });
+      this.redoStack = [];
+    }
+    this.sharp = sharpAfter;
+    this.settings = settingsAfter;
     return true;
+  }
+
+  /** Ends the open change (a slider drag released): later changes are undone separately. */
+  closeChange(): void {
+    const last = this.undoStack[this.undoStack.length - 1];
+    if (last) last.open = false;
   }
 
   /** Toggles one edge; boundary edges cannot be toggled. */
@@ -66,8 +115,12 @@ export class FeatureSet {
     return this.commit(change);
   }
 
-  /** Replaces the edges of the previous sharp threshold by `edges` (keeps edges marked by hand). */
-  setSharp(edges: Uint32Array | null): boolean {
+  /**
+   * Replaces the edges of the previous sharp threshold by `edges` (keeps
+   * edges marked by hand), found with `settings` (null: detection off);
+   * `drag`: part of a slider drag, one undo step with the rest of it.
+   */
+  setSharp(edges: Uint32Array | null, settings: SharpSettings | null = null, drag = false): boolean {
     const next = new Uint8Array(this.edgeCount);
     if (edges) for (const e of edges) if (!this.boundary[e]) next[e] = 1;
     const change: number[] = [];
@@ -75,29 +128,44 @@ export class FeatureSet {
       const want = next[e] ? 1 : this.sharp[e] ? 0 : this.flags[e]!;
       if (want !== this.flags[e]) change.push(e);
     }
-    this.sharp = next;
-    return this.commit(change);
+    return this.commit(change, next, settings, drag);
   }
 
+  /** Unmarks every edge and turns the detection off. */
   clear(): boolean {
     const change: number[] = [];
     for (let e = 0; e < this.edgeCount; e++) if (this.flags[e]) change.push(e);
-    this.sharp.fill(0);
-    return this.commit(change);
+    return this.commit(change, new Uint8Array(this.edgeCount), null);
   }
 
+  /** Replaces every mark by `edges` (an imported list; detection off). */
+  replaceAll(edges: Uint32Array): boolean {
+    const want = new Uint8Array(this.edgeCount);
+    for (const e of edges) if (e < this.edgeCount && !this.boundary[e]) want[e] = 1;
+    const change: number[] = [];
+    for (let e = 0; e < this.edgeCount; e++) if (want[e] !== this.flags[e]) change.push(e);
+    return this.commit(change, new Uint8Array(this.edgeCount), null);
+  }
+
+  /** Undoes the last change (its marks, sharp edges and settings); false when there is none. */
   undo(): boolean {
     const change = this.undoStack.pop();
     if (!change) return false;
-    this.flip(change);
+    change.open = false;
+    this.flip(change.edges);
+    this.sharp = change.sharpBefore;
+    this.settings = change.settingsBefore;
     this.redoStack.push(change);
     return true;
   }
 
+  /** Redoes the last undone change; false when there is none. */
   redo(): boolean {
     const change = this.redoStack.pop();
     if (!change) return false;
-    this.flip(change);
+    this.flip(change.edges);
+    this.sharp = change.sharpAfter;
+    this.settings = change.settingsAfter;
     this.undoStack.push(change);
     return true;
   }

@@ -8,6 +8,7 @@ import { Panels, type Sample, type Stats } from './panels';
 import type { Stage, WireFile } from './protocol';
 import { PageStore, mirrorToDataset } from './state';
 import { installHooks } from './test-hooks';
+import { wireViewKeys } from './view-keys';
 import { Viewer } from './viewer';
 import { MeshWorker } from './worker-client';
 
@@ -18,6 +19,7 @@ mirrorToDataset(store, document.body.dataset);
 
 const panels = new Panels();
 const viewer = new Viewer($('viewport'));
+wireViewKeys(viewer);
 const worker = new MeshWorker();
 const editor = new Editor(viewer, worker, store, hooks);
 
@@ -164,12 +166,18 @@ window.__conemapTest = {
   projectEdge: (e) => editor.features.projectEdge(e),
   visibleEdge: () => editor.features.visibleEdge(),
   edgeAt: (x, y) => editor.features.edgeAt(x, y),
+  pick: (x, y) => {
+    const p = viewer.pick(x, y);
+    return p ? { face: p.face, sideDistance: p.sideDistance } : null;
+  },
+  featureIds: () => Array.from(editor.features.mesh?.features?.ids() ?? []),
   setHelper: (minFaces, wait) => store.setTuning({ helperMinFaces: minFaces, helperWait: wait }),
   setMaxConeRefinements: (n) => store.setTuning({ maxConeRefinements: n }),
   vertexPosition: (v) => editor.features.vertexPosition(v),
   projectVertex: (v) => editor.features.projectVertex(v),
   edgeEnds: (e) => editor.features.edgeEnds(e),
   setQuadCount: (n) => editor.quads.setCount(n),
+  cameraTarget: () => viewer.target.toArray(),
   projectUvFace: (f) => editor.results.projectUvFace(f),
 };
 

@@ -1,5 +1,6 @@
-// The left panel: status line with progress, error box, stats table, problems
-// list, samples menu. Pure DOM; no knowledge of the worker or the viewer.
+// The left panel: status line with progress, error box, stats table, samples
+// menu. Pure DOM; no knowledge of the worker or the viewer (the problems list
+// is mesh-problems.ts).
 import { $, definitionList, fmtBytes, fmtInt, fmtMs } from './dom';
 import type { MeshReport } from './protocol';
 
@@ -32,7 +33,6 @@ export class Panels {
   private readonly progress = $<HTMLProgressElement>('progress');
   private readonly error = $('error');
   private readonly stats = $('stats');
-  private readonly problems = $('problems');
   readonly samples = $<HTMLSelectElement>('samples');
 
   setStatus(text: string, busy: boolean, fraction?: number): void {
@@ -90,41 +90,6 @@ export class Panels {
     }
     rows.push(['Import time', fmtMs(s.importMs)]);
     this.stats.replaceChildren(definitionList(rows));
-    this.showProblems(r);
-  }
-
-  private showProblems(r: MeshReport | null): void {
-    this.problems.replaceChildren();
-    const heading = document.createElement('h2');
-    heading.textContent = 'Problems';
-    if (!r) {
-      this.problems.hidden = true;
-      return;
-    }
-    this.problems.hidden = false;
-    const messages: string[] = r.problem_messages ?? r.problems?.map((p) => JSON.stringify(p)) ?? [];
-    if (messages.length === 0) {
-      const ok = document.createElement('p');
-      ok.className = 'ok';
-      ok.textContent = 'None found.';
-      this.problems.append(heading, ok);
-      return;
-    }
-    heading.textContent = `Problems (${messages.length})`;
-    const list = document.createElement('ul');
-    const shown = 100;
-    for (const m of messages.slice(0, shown)) {
-      const li = document.createElement('li');
-      li.textContent = m;
-      list.append(li);
-    }
-    if (messages.length > shown) {
-      const li = document.createElement('li');
-      li.className = 'more';
-      li.textContent = `… and ${messages.length - shown} more`;
-      list.append(li);
-    }
-    this.problems.append(heading, list);
   }
 
   setSamples(samples: Sample[], selected: string): void {

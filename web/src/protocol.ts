@@ -20,6 +20,8 @@ export type Request =
       simulateTrap?: boolean;
     }
   | { id: number; type: 'sharp'; degrees: number; minEdges: number; closedOnly: boolean }
+  /** Edge ids of the open mesh named by a features file or JSON report (`text`); answers a `Uint32Array`. */
+  | { id: number; type: 'features-from-json'; text: string }
   // A solve in steps (so that a helper worker can place some components):
   // begin → place every component (here, or in a helper and then add) → finish.
   | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean; freeBoundary?: boolean; maxConeRefinements?: number | undefined }
@@ -47,7 +49,10 @@ export interface MeshReport {
   euler_characteristic: number;
   genus: number[];
   problems: Array<{ kind: string; [index: string]: unknown }>;
+  /** One line per problem, elements numbered as the file does (OBJ 1-based; glTF mesh, primitive, accessor index). */
   problem_messages: string[];
+  /** The problems located on the mesh as shown (crate `mesh::LocatedProblem`). */
+  located_problems: LocatedProblem[];
   /** Further figures the library may add; shown when present. */
   edges?: number;
   boundary_edges?: number;
@@ -55,6 +60,20 @@ export interface MeshReport {
   merged_vertices?: number;
   /** Per component: whether `genus` is meaningful there. */
   component_is_manifold?: boolean[];
+}
+
+/**
+ * A mesh problem (crate `mesh::LocatedProblem`): its kind, its message in the
+ * file's numbering, whether it blocks solving, and the elements it names in
+ * the ids of the shown mesh (edges as vertex pairs, flat; faces as triangles).
+ */
+export interface LocatedProblem {
+  kind: string;
+  message: string;
+  blocking: boolean;
+  vertices: number[];
+  edges: number[];
+  faces: number[];
 }
 
 export interface ImportResult {
@@ -74,6 +93,8 @@ export interface ImportResult {
   /** Milliseconds spent in the wasm import and in the edge extraction. */
   timings: { import: number; edges: number };
   version: string;
+  /** The library's α_smooth defaults (wasm `default_alpha`): plain, and with MIQ emulation. */
+  alphaDefaults: { plain: number; miq: number };
 }
 
 export interface Cone {
@@ -364,7 +385,7 @@ export interface ErrorLocation {
 }
 
 export type Response =
-  | { id: number; type: 'progress'; stage: string; step?: number; remaining?: number }
+  | { id: number; type: 'progress'; stage: string; step?: number; remaining?: number; fraction?: number }
   | { id: number; type: 'result'; value: unknown }
   | {
       id: number;

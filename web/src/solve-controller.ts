@@ -1,9 +1,12 @@
-// The solve controls: α_smooth, MIQ, free boundary, Run and Cancel; a solve
-// through the worker with its progress line, handed to the result panel once
-// the solver answers, and one end for every solve (success, failure, cancel);
-// the solve error box, with the mesh elements it names highlighted in 3D.
+// The solve controls: α_smooth, MIQ (which sets α to the library's MIQ
+// default), free boundary, Run (off, with the reason, on a mesh that cannot
+// be solved) and Cancel (also Esc); a solve through the worker with its
+// progress line, handed to the result panel once the solver answers, and one
+// end for every solve (success, failure, cancel); the solve error box, with
+// the mesh elements it names highlighted in 3D.
 import { $, fmtInt } from './dom';
 import type { FeatureEditor } from './feature-editor';
+import type { MeshProblems } from './mesh-problems';
 import { COLORS } from './palette';
 import type { ErrorLocation } from './protocol';
 import type { ResultPanel } from './result-panel';
@@ -18,6 +21,18 @@ type Outcome = { kind: 'solved' } | { kind: 'cancelled' } | { kind: 'failed'; me
 /** α_smooth of the slider's position (a power of ten). */
 const alphaOf = (slider: number): number => 10 ** slider;
 
+/** Plain words for the kinds of blocking problems (crate `Problem` kinds). */
+const KIND_WORDS: Record<string, string> = {
+  non_manifold_edge: 'edges with more than two faces',
+  inconsistent_orientation: 'faces oriented inconsistently',
+  zero_area_face: 'faces of zero area',
+  zero_length_edge: 'edges of zero length',
+  degenerate_face: 'degenerate faces',
+  duplicate_face: 'duplicate faces',
+  non_finite_coordinate: 'vertices with NaN coordinates',
+  index_out_of_range: 'faces with bad vertex indices',
+};
+
 /** α_smooth as shown beside the slider (fewer decimals for larger values). */
 function alphaText(a: number): string {
   return a >= 10 ? a.toFixed(0) : a >= 1 ? a.toFixed(2) : a >= 0.01 ? a.toFixed(3) : a.toExponential(1);
@@ -31,6 +46,8 @@ export class SolveController {
   private problem: ErrorLocation | null = null;
   /** Remaining count at the start of the rounding stage (for its progress fraction). */
   private roundingStart = 0;
+  /** The slider's position before MIQ emulation set it to the MIQ default (restored when unticked). */
+  private alphaBeforeMiq: string | null = null;
   private readonly el = {
     alpha: $<HTMLInputElement>('alpha'),
     alphaValue: $<HTMLOutputElement>('alpha-value'),
@@ -51,6 +68,7 @@ export class SolveController {
     private readonly worker: MeshWorker,
     private readonly store: PageStore,
     private readonly features: FeatureEditor,
+    private readonly problems: MeshProblems,
     private readonly results: ResultPanel,
     private readonly hooks: Pick<Hooks, 'solveError' | 'solveErrorLocation' | 'errorHighlight' | 'solves'>,
   ) {
@@ -60,12 +78,39 @@ export class SolveController {
     };
     el.alpha.addEventListener('input', showAlpha);
     showAlpha();
+    el.miq.addEventListener('change', () => {
+      this.followMiq();
+      showAlpha();
+    });
     el.run.addEventListener('click', () => void this.start());
     el.cancel.addEventListener('click', () => this.cancel());
+    window.addEventListener('keydown', (e) => {
+      if (e.key === 'Escape' && this.active !== null) {
+        e.preventDefault();
+        this.cancel();
+      }
+    });
     store.subscribe((s) => this.render(s));
   }
 
-  /** Resets the error box, status and note for the mesh the feature editor has just opened. */
+  /**
+   * With MIQ emulation ticked, α_smooth goes to the library's MIQ default
+   * (the paper's "100.0*": large α without the harmonic-minimality
+   * constraint, as the CLI's --miq); unticked, back to where it was.
+   */
+  private followMiq(): void {
+    const el = this.el;
+    const defaults = this.features.mesh?.data.alphaDefaults;
+    if (el.miq.checked && defaults) {
+      this.alphaBeforeMiq = el.alpha.value;
+      el.alpha.value = String(Math.log10(defaults.miq));
+    } else if (!el.miq.checked && this.alphaBeforeMiq !== null) {
+      el.alpha.value = this.alphaBeforeMiq;
+      this.alphaBeforeMiq = null;
+    }
+  }
+
+  /** Resets the error box, status and note for the mesh the feature editor has just opened; on a mesh that cannot be solved, says why Run is off. */
   meshChanged(): void {
     const valid = this.features.mesh?.data.valid ?? false;
     this.clearProblem();
@@ -73,10 +118,17 @@ export class SolveController {
     this.el.error.hidden = true;
     this.el.status.hidden = true;
     this.el.note.hidden = valid;
-    this.el.note.textContent = valid
-      ? ''
-      : 'This mesh has blocking problems (see below): features cannot be marked and Run will report why it cannot be parametrized.';
+    this.el.note.textContent = valid ? '' : this.blockedReason();
+    this.el.run.title = valid ? 'Compute cones and the seamless map' : this.el.note.textContent;
     this.render(this.store.state);
+  }
+
+  /** Why the open mesh cannot be solved, in plain words (its blocking problems by kind). */
+  private blockedReason(): string {
+    const kinds = new Map<string, number>();
+    for (const p of this.problems.blocking) kinds.set(p.kind, (kinds.get(p.kind) ?? 0) + 1);
+    const what = [...kinds].map(([k, n]) => `${fmtInt(n)} ${KIND_WORDS[k] ?? k.replace(/_/g, ' ')}`).join(', ');
+    return `Run is off: this mesh cannot be parametrized (${what || 'blocking problems'}). Repair it in a mesh editor; the Problems list below shows each one in 3D.`;
   }
 
   /** After an edit of the features: drops the error highlight (it was about the old ones) and says when the shown result is out of date. */
@@ -91,7 +143,7 @@ export class SolveController {
   /** Runs a solve of the open mesh with the features and settings shown; resolves once it has ended (see `end`). */
   async start(): Promise<void> {
     const m = this.features.mesh;
-    if (!m || !canTransition(this.store.state.phase, 'solving')) return;
+    if (!m?.data.valid || !canTransition(this.store.state.phase, 'solving')) return;
     const features = m.features?.ids() ?? new Uint32Array(0);
     const alpha = alphaOf(Number(this.el.alpha.value));
     const miq = this.el.miq.checked;
@@ -114,8 +166,8 @@ export class SolveController {
     const t0 = performance.now();
     let outcome: Outcome;
     try {
-      const result = await this.worker.solve(features, alpha, miq, (stage, step, remaining) => {
-        if (this.active === run) this.setProgress(stage, step, remaining);
+      const result = await this.worker.solve(features, alpha, miq, (stage, step, remaining, fraction) => {
+        if (this.active === run) this.setProgress(stage, step, remaining, fraction);
       }, freeBoundary, this.store.state.tuning);
       if (this.active !== run) return;
       this.store.transition('solving', { building: true });
@@ -165,7 +217,7 @@ export class SolveController {
   /** The controls as `state` and the open mesh allow: Run when a solve may start, Cancel while one runs (until its view is built). */
   private render(state: PageState): void {
     const solving = state.phase === 'solving';
-    this.el.run.disabled = !this.features.mesh || !canTransition(state.phase, 'solving');
+    this.el.run.disabled = !this.features.mesh?.data.valid || !canTransition(state.phase, 'solving');
     this.el.cancel.disabled = !solving || state.building;
     this.el.progress.hidden = !solving;
   }
@@ -245,8 +297,12 @@ export class SolveController {
     this.viewer.frameOn(p.vertices.length > 0 ? p.vertices : ends);
   }
 
-  /** The progress line's text and bar fraction (undefined: indeterminate) for a report of `stage` at `step` with `remaining` to go. */
-  private progressText(stage: string, step = 0, remaining = 0): [string, number | undefined] {
+  /**
+   * The progress line's text and bar fraction (undefined: indeterminate) for
+   * a report of `stage` at `step` with `remaining` to go, `fraction` of the
+   * stage done where the library knows it.
+   */
+  private progressText(stage: string, step = 0, remaining = 0, fraction?: number): [string, number | undefined] {
     switch (stage) {
       case 'starting':
         return ['Starting…', undefined];
@@ -258,7 +314,7 @@ export class SolveController {
         return [`Rounding: round ${step + 1} (${fmtInt(remaining)} remaining)`, frac];
       }
       case 'cone moves':
-        return [`Cone moves: pass ${step + 1}`, undefined];
+        return [`Cone moves: pass ${step + 1}${fraction === undefined ? '' : ` (${fmtInt(remaining)} cones to try)`}`, fraction];
       case 'cut':
         return ['Cutting the mesh open', undefined];
       case 'cross-field':
@@ -273,7 +329,7 @@ export class SolveController {
       case 'injective':
         return [`Injective refinement: iteration ${step} of at most ${fmtInt(remaining)}`, remaining ? step / remaining : undefined];
       case 'pair cancellation':
-        return [`Cancelling cone pairs (${fmtInt(step)} removed)`, undefined];
+        return [`Cancelling cone pairs (${fmtInt(step)} removed${fraction === undefined ? '' : `, ${fmtInt(remaining)} pairs to try`})`, fraction];
       case 'building view':
         return ['Building the view…', undefined];
       default: {
@@ -284,8 +340,8 @@ export class SolveController {
     }
   }
 
-  private setProgress(stage: string, step?: number, remaining?: number): void {
-    const [text, frac] = this.progressText(stage, step, remaining);
+  private setProgress(stage: string, step?: number, remaining?: number, fraction?: number): void {
+    const [text, frac] = this.progressText(stage, step, remaining, fraction);
     this.el.stage.textContent = text;
     if (frac === undefined) this.el.bar.removeAttribute('value');
     else this.el.bar.value = Math.max(0, Math.min(1, frac));

@@ -69,6 +69,10 @@ export interface Hooks {
   timings: { read: number; worker: number; draw: number } | null;
   /** Marked feature edges (without the fixed boundary edges). */
   features: number;
+  /** The edge highlighted under the pointer (a click would toggle it), or null. */
+  hoverEdge: number | null;
+  /** The mesh problem last clicked in the Problems list: its index there and the vertices the view framed; null when none. */
+  problemFocus: { index: number; vertices: number[] } | null;
   /** Figures of the last finished solve (null before one, or after a new mesh). */
   result: ResultHook | null;
   /** Message of the last failed solve (null after a successful one). */
@@ -100,6 +104,10 @@ export interface TestActions {
   visibleEdge(): number;
   /** Edge id a click at (x, y) would toggle; -1 when none. */
   edgeAt(x: number, y: number): number;
+  /** The face under (x, y) and the distance (CSS px) from there to its nearest side; null off the mesh. */
+  pick(x: number, y: number): { face: number; sideDistance: number } | null;
+  /** Ids of the marked feature edges, ascending. */
+  featureIds(): number[];
   /** Smallest mesh (faces) whose solves use a helper worker; `wait`: start placing once it is ready. */
   setHelper(minFaces: number, wait: boolean): void;
   /** Refinements around cones of angle 0 before a solve fails (undefined: the default; 0 shows the raw placement's error). */
@@ -110,6 +118,8 @@ export interface TestActions {
   edgeEnds(e: number): [number, number] | null;
   /** Sets the quad-count slider to about `n` quads and asks for them at once (quad mode must be on). */
   setQuadCount(n: number): void;
+  /** Where the 3D view's camera looks (the orbit centre), mesh coordinates. */
+  cameraTarget(): [number, number, number];
   /** Page position (client CSS px) of the centroid of face `face` in the UV view, and the distance from it to the farthest corner; null when no layout is shown. */
   projectUvFace(face: number): { x: number; y: number; radius: number } | null;
 }
@@ -129,7 +139,7 @@ export function installHooks(store: PageStore): Hooks {
       return store.state.phase;
     },
     stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
-    features: 0, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
+    features: 0, hoverEdge: null, problemFocus: null, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
     uvView: null, quads: null, quadsError: null, quadRuns: 0,
   };
   window.__conemap = hooks;

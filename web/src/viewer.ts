@@ -440,6 +440,21 @@ export class Viewer {
     return { face, side, sideDistance, vertex, vertexDistance, point: hit.point };
   }
 
+  /** The orbit centre the camera looks at, mesh coordinates (a copy). */
+  get target(): THREE.Vector3 {
+    return this.controls.target.clone();
+  }
+
+  /** Turns the camera about the orbit centre by `left` and `up` radians (keyboard orbit). */
+  orbit(left: number, up: number): void {
+    const s = new THREE.Spherical().setFromVector3(this.camera.position.clone().sub(this.controls.target));
+    s.theta -= left;
+    s.phi = THREE.MathUtils.clamp(s.phi - up, 0.01, Math.PI - 0.01);
+    this.camera.position.copy(this.controls.target).add(new THREE.Vector3().setFromSpherical(s));
+    this.controls.update();
+    this.loop.request();
+  }
+
   /** Points the camera at the mesh's bounding sphere. */
   frame(): void {
     const sphere = this.mesh?.geometry.boundingSphere;

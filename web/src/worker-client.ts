@@ -30,7 +30,8 @@ export class LocatedError extends Error {
   }
 }
 
-export type ProgressFn = (stage: string, step?: number, remaining?: number) => void;
+/** A progress report: the stage, two counters, and the share of the stage done (0..1) where the library knows it. */
+export type ProgressFn = (stage: string, step?: number, remaining?: number, fraction?: number) => void;
 
 interface Pending {
   resolve: (value: unknown) => void;
@@ -125,7 +126,7 @@ export class MeshWorker {
     if (!p) return;
     switch (msg.type) {
       case 'progress':
-        p.onProgress(msg.stage, msg.step, msg.remaining);
+        p.onProgress(msg.stage, msg.step, msg.remaining, msg.fraction);
         break;
       case 'result':
         this.pending.delete(msg.id);
@@ -176,6 +177,11 @@ export class MeshWorker {
     return this.send<SharpResult>({ type: 'sharp', degrees, minEdges, closedOnly });
   }
 
+  /** Edge ids of the open mesh that a features file or JSON report (`text`) names by position; rejects saying what does not match. */
+  featuresFromJson(text: string): Promise<Uint32Array> {
+    return this.send<Uint32Array>({ type: 'features-from-json', text });
+  }
+
   /**
    * Cones and UVs for the open mesh, in steps: begin, place every component
    * (some in a helper worker on large meshes), finish. Progress comes from this
@@ -201,10 +207,10 @@ export class MeshWorker {
     // Every request opens with a 'starting' report: not news in the middle of
     // a solve. Components go largest first, to two workers: 'topology'
     // reports count the components placed so far rather than naming one.
-    const placing: ProgressFn = (stage, step, remaining) => {
+    const placing: ProgressFn = (stage, step, remaining, fraction) => {
       if (stage === 'starting') return;
       if (stage === 'topology') onProgress(stage, Math.min(placed, total - 1), total);
-      else onProgress(stage, step, remaining);
+      else onProgress(stage, step, remaining, fraction);
     };
     const own = async (): Promise<void> => {
       if (helper && tuning.helperWait) await helper.ready.catch(() => {});

@@ -2,7 +2,7 @@
 // with `Response`s (see protocol.ts); result buffers are transferred, not copied.
 // Keeps the last opened mesh as a `MeshSession` so that sharp-edge queries and
 // solves do not re-import it, and quads re-use the session's last solve.
-import init, { MeshSession, version } from '@conemap/wasm';
+import init, { MeshSession, default_alpha, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
 import type { ErrorLocation, ImportResult, MeshReport, QuadsResult, Request, Response, SharpResult, SolveResult, SolveView, WasmSolveResult } from './protocol';
 import { buildSolveView, viewBuffers } from './solve-view';
@@ -18,7 +18,8 @@ let ready: Promise<unknown> | null = null;
 const wasmReady = (): Promise<unknown> =>
   (ready ??= init({ module_or_path: new URL('./pkg/conemap_bg.wasm', import.meta.url) }));
 
-type Progress = (stage: string, step: number, remaining: number) => void;
+/** A progress report: the stage, two counters, and the share of the stage done where the library knows it. */
+type Progress = (stage: string, step: number, remaining: number, fraction?: number) => void;
 /** The session API as the page uses it. */
 interface Session {
   report(): MeshReport;
@@ -29,7 +30,9 @@ interface Session {
   boundary_edges(): Uint32Array;
   sharp_edges(degrees: number): Uint32Array;
   sharp_curves(degrees: number, minEdges: number, closedOnly: boolean): SharpResult;
-  solve_begin(features: Uint32Array, alpha: number, miq: boolean): Uint32Array;
+  features_from_json(text: string): Uint32Array;
+  /** `alpha` undefined: the library's default for `miq` (`default_alpha`). */
+  solve_begin(features: Uint32Array, alpha: number | undefined, miq: boolean): Uint32Array;
   set_max_cone_refinements(n: number | undefined): void;
   set_free_boundary(free: boolean): void;
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
@@ -104,6 +107,7 @@ function openMesh(req: Extract<Request, { type: 'import' }>): Answer {
     adjacency,
     timings: { import: t1 - t0, edges: t2 - t1 },
     version: version(),
+    alphaDefaults: { plain: default_alpha(false), miq: default_alpha(true) },
   };
   const transfer: Transferable[] = [positions.buffer, indices.buffer, boundary.buffer, faceEdgeIds.buffer];
   if (edges) transfer.push(edges.buffer);
@@ -120,12 +124,12 @@ function requireSession(): Session {
 function throttledProgress(id: number): Progress {
   let lastPost = 0;
   let lastStage = '';
-  return (stage, step, remaining) => {
+  return (stage, step, remaining, fraction) => {
     const now = performance.now();
     if (stage === lastStage && now - lastPost < 30) return;
     lastPost = now;
     lastStage = stage;
-    post({ id, type: 'progress', stage, step, remaining });
+    post({ id, type: 'progress', stage, step, remaining, ...(fraction === undefined ? {} : { fraction }) });
   };
 }
 
@@ -214,6 +218,11 @@ async function handle(req: Request): Promise<void> {
       case 'sharp': {
         const found = requireSession().sharp_curves(req.degrees, req.minEdges, req.closedOnly);
         out = { value: found, transfer: [found.edges.buffer] };
+        break;
+      }
+      case 'features-from-json': {
+        const ids = requireSession().features_from_json(req.text);
+        out = { value: ids, transfer: [ids.buffer] };
         break;
       }
       case 'solve-begin':

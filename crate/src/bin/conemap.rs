@@ -5,7 +5,7 @@
 
 use conemap::cones::{self, BoundaryMode, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;
-use conemap::mesh::{analyze, MeshReport, TriMesh};
+use conemap::mesh::{analyze_located, Located, RawMesh, TriMesh};
 use conemap::param::quantize::{GridSize, IntegerGridMap, QuantizeReport};
 use std::path::Path;
 use std::process::ExitCode;
@@ -270,18 +270,20 @@ impl Args {
 
 fn info_command(args: &Args) -> Result<(), Failure> {
     let file = args.file()?;
-    let raw = conemap::io::import_path(Path::new(file)).map_err(|e| Failure(e.to_string(), 1))?;
-    let report = analyze(&raw);
+    let input = conemap::io::import_path_numbered(Path::new(file)).map_err(|e| Failure(e.to_string(), 1))?;
+    let located = analyze_located(&input.raw, &input.numbering);
     if args.flag("--json") {
-        let json = serde_json::to_string(&report).map_err(|e| Failure(e.to_string(), 1))?;
+        let json = serde_json::to_string(&located.report).map_err(|e| Failure(e.to_string(), 1))?;
         println!("{json}");
     } else {
-        print_report(file, &report);
+        print_report(file, &located);
     }
     Ok(())
 }
 
-fn print_report(file: &str, r: &MeshReport) {
+/// Prints the figures of `located` and its problems, named as the file numbers its elements.
+fn print_report(file: &str, located: &Located) {
+    let r = &located.report;
     println!("{file}");
     println!(
         "  vertices: {} (source vertices: {}, merged by welding: {})",
@@ -319,8 +321,8 @@ fn print_report(file: &str, r: &MeshReport) {
     } else {
         println!("  problems: {} ({blocking} blocking)", r.problems.len());
         const MAX_PROBLEMS: usize = 50;
-        for p in r.problems.iter().take(MAX_PROBLEMS) {
-            println!("    {p}");
+        for p in located.problems.iter().take(MAX_PROBLEMS) {
+            println!("    {}", p.message);
         }
         if r.problems.len() > MAX_PROBLEMS {
             println!("    … and {} more (use --json for all)", r.problems.len() - MAX_PROBLEMS);
@@ -330,9 +332,16 @@ fn print_report(file: &str, r: &MeshReport) {
 
 /// Reads FILE and builds the validated mesh; problems become one message.
 fn load_mesh(file: &str) -> Result<TriMesh, Failure> {
-    let raw = conemap::io::import_path(Path::new(file)).map_err(|e| Failure(e.to_string(), 1))?;
-    TriMesh::from_raw(&raw).map_err(|problems| {
-        let first = problems.first().map(|p| p.to_string()).unwrap_or_default();
+    let input = conemap::io::import_path_numbered(Path::new(file)).map_err(|e| Failure(e.to_string(), 1))?;
+    validated(file, &input.raw, &input.numbering)
+}
+
+/// The validated mesh of `raw`, or a failure naming its first blocking
+/// problem (elements numbered as the file does) and how many there are.
+fn validated(file: &str, raw: &RawMesh, numbering: &conemap::io::FileNumbering) -> Result<TriMesh, Failure> {
+    TriMesh::from_raw(raw).map_err(|problems| {
+        let located = analyze_located(raw, numbering);
+        let first = located.problems.iter().find(|p| p.blocking).map(|p| p.message.clone()).unwrap_or_default();
         let more = if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
         Failure(format!("{file}: cannot be parametrized: {first}{more}"), 1)
     })
@@ -368,12 +377,8 @@ fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
     }
     if let Some(path) = args.value("--features") {
         let text = std::fs::read_to_string(path).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
-        #[derive(serde::Deserialize)]
-        struct FeatureFile {
-            edges: Vec<[[f64; 3]; 2]>,
-        }
-        let list: FeatureFile = serde_json::from_str(&text).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
-        let given = FeatureSet::from_positions(mesh, &list.edges).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
+        let edges = conemap::io::parse_feature_edges(&text).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
+        let given = FeatureSet::from_positions(mesh, &edges).map_err(|e| Failure(format!("{path}: {e}"), 1))?;
         features.union(&given);
     }
     Ok(features)
@@ -425,9 +430,11 @@ impl ProgressLine {
             Rounding { component, round, free } => {
                 format!("cones: component {}, rounding round {round}, {free} integers free", component + 1)
             }
-            ConeMoves { component, pass } => format!("cones: component {}, cone moves, pass {}", component + 1, pass + 1),
-            PairCancellation { component, removed } => {
-                format!("cones: component {}, pair cancellation, {removed} removed", component + 1)
+            ConeMoves { component, pass, tried, cones } => {
+                format!("cones: component {}, cone moves, pass {}, {tried} of {cones} cones tried", component + 1, pass + 1)
+            }
+            PairCancellation { component, removed, tried, trials } => {
+                format!("cones: component {}, pair cancellation, {removed} removed, {tried} of {trials} pairs tried", component + 1)
             }
         });
     }
@@ -536,7 +543,6 @@ fn print_cones(file: &str, mesh: &TriMesh, features: &FeatureSet, options: &Cone
 /// (and the report when asked), print the summary.
 fn solve_command(args: &Args) -> Result<(), Failure> {
     use conemap::export::{self, ExportInput, ExportOptions, Format};
-    use conemap::mesh::RawMesh;
 
     let file = args.file()?;
     let out = args.value("-o").or_else(|| args.value("--output")).ok_or_else(|| usage("solve needs -o OUT"))?;
@@ -683,12 +689,8 @@ fn read_input(file: &str) -> Result<InputMesh, Failure> {
     let name = Path::new(file).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let main = InputFile { name, bytes };
     let others = io::gltf::sibling_buffers(Path::new(file), &main).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
-    let (raw, source) = io::import_with_source(&main, &others).map_err(|e| Failure(e.to_string(), 1))?;
-    let mesh = TriMesh::from_raw(&raw).map_err(|problems| {
-        let first = problems.first().map(|p| p.to_string()).unwrap_or_default();
-        let more = if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
-        Failure(format!("{file}: cannot be parametrized: {first}{more}"), 1)
-    })?;
+    let io::Imported { raw, gltf: source, numbering } = io::import_file(&main, &others).map_err(|e| Failure(e.to_string(), 1))?;
+    let mesh = validated(file, &raw, &numbering)?;
     Ok(InputMesh { main, others, raw, source, mesh })
 }
 

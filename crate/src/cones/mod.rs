@@ -147,10 +147,12 @@ pub enum ConeProgress {
     Topology { component: usize, components: usize },
     /// Rounding round `round`: `free` integers still unrounded.
     Rounding { component: usize, round: usize, free: usize },
-    /// Cone-location pass `pass`.
-    ConeMoves { component: usize, pass: usize },
-    /// Pair cancellation: `removed` pairs so far.
-    PairCancellation { component: usize, removed: usize },
+    /// Cone-location pass `pass`: `tried` of the pass's `cones` candidate
+    /// cones evaluated so far.
+    ConeMoves { component: usize, pass: usize, tried: usize, cones: usize },
+    /// Pair cancellation: `removed` pairs so far; in the current round,
+    /// `tried` of its `trials` candidate pairs evaluated.
+    PairCancellation { component: usize, removed: usize, tried: usize, trials: usize },
 }
 
 /// A cone or boundary corner: `k` quarter turns of curvature (cone angle

@@ -65,13 +65,17 @@ fn improve(
     progress: &mut dyn FnMut(ConeProgress),
 ) -> Result<(usize, usize, usize, usize), ConeError> {
     let moves = if options.optimize_locations {
-        sys.optimize_locations(options.max_move_passes, &mut |pass| progress(ConeProgress::ConeMoves { component: c, pass }))?
+        sys.optimize_locations(options.max_move_passes, &mut |pass, tried, cones| {
+            progress(ConeProgress::ConeMoves { component: c, pass, tried, cones })
+        })?
     } else {
         0
     };
     let merged = if options.merge_close_pairs { sys.merge_close_pairs()? } else { 0 };
     let cancelled = if options.cancel_pairs_nearest > 0 {
-        sys.cancel_pairs(options.cancel_pairs_nearest, &mut |n| progress(ConeProgress::PairCancellation { component: c, removed: n }))?
+        sys.cancel_pairs(options.cancel_pairs_nearest, &mut |removed, tried, trials| {
+            progress(ConeProgress::PairCancellation { component: c, removed, tried, trials })
+        })?
     } else {
         0
     };
@@ -304,7 +308,7 @@ impl ConeProblem {
                     let given: Vec<i64> = lsys.tree.vertices.iter().map(|&v| k[to_sub[v as usize] as usize]).collect();
                     lsys.fix_indices(&given).ok()?;
                     if options.optimize_locations {
-                        lsys.optimize_locations(options.max_move_passes, &mut |_| {}).ok()?;
+                        lsys.optimize_locations(options.max_move_passes, &mut |_, _, _| {}).ok()?;
                     }
                 }
             }

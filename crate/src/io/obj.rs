@@ -16,20 +16,33 @@ use crate::{ImportError, RawMesh};
 /// Parses an OBJ file: `v` lines and `f` lines (polygons fan-triangulated,
 /// negative indices, `v`, `v/vt`, `v//vn`, `v/vt/vn` forms).
 pub fn import(file: &InputFile) -> Result<RawMesh, ImportError> {
-    let mesh = parse(&file.bytes)?;
+    import_numbered(file).map(|(mesh, _)| mesh)
+}
+
+/// Like [`import`], also returning the 1-based `f` statement each triangle
+/// came from (see [`super::FileNumbering::Obj`]).
+pub fn import_numbered(file: &InputFile) -> Result<(RawMesh, Vec<u32>), ImportError> {
+    let (mesh, faces) = parse_numbered(&file.bytes)?;
     if mesh.triangles.is_empty() {
         return Err(ImportError::NoTriangles { name: file.name.clone() });
     }
-    Ok(mesh)
+    Ok((mesh, faces))
 }
 
 /// Parses OBJ bytes (any encoding: only ASCII statements are interpreted).
 /// An empty result is not an error here; [`import`] turns it into `NoTriangles`.
 pub fn parse(bytes: &[u8]) -> Result<RawMesh, ImportError> {
+    parse_numbered(bytes).map(|(mesh, _)| mesh)
+}
+
+/// [`parse`], with the 1-based `f` statement of each triangle.
+fn parse_numbered(bytes: &[u8]) -> Result<(RawMesh, Vec<u32>), ImportError> {
     let mut st = State {
         positions: Vec::with_capacity(bytes.len() / 80),
         triangles: Vec::with_capacity(bytes.len() / 40),
         poly: Vec::with_capacity(8),
+        faces: 0,
+        face_of_triangle: Vec::with_capacity(bytes.len() / 40),
     };
     let mut pos = 0usize;
     let mut line_no = 0usize;
@@ -63,7 +76,7 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, ImportError> {
         }
         st.line(line).map_err(|d| malformed(first_line, d))?;
     }
-    Ok(RawMesh { positions: st.positions, triangles: st.triangles })
+    Ok((RawMesh { positions: st.positions, triangles: st.triangles }, st.face_of_triangle))
 }
 
 fn malformed(line: usize, detail: String) -> ImportError {
@@ -95,6 +108,9 @@ struct State {
     positions: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
     poly: Vec<u32>,
+    /// `f` statements read so far, and the (1-based) one of each triangle.
+    faces: u32,
+    face_of_triangle: Vec<u32>,
 }
 
 /// Splits off the next whitespace-separated token at or after `*p`.
@@ -152,8 +168,10 @@ impl State {
                     return Err(format!("face has {} vertices, needs at least 3", self.poly.len()));
                 }
                 let v0 = self.poly[0];
+                self.faces += 1;
                 for w in self.poly[1..].windows(2) {
                     self.triangles.push([v0, w[0], w[1]]);
+                    self.face_of_triangle.push(self.faces);
                 }
             }
             _ => {}
@@ -247,6 +265,8 @@ mod tests {
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.positions[1], [1.0, 0.0, 0.0]);
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 1, 2]]);
+        let (_, faces) = parse_numbered(b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3\n").unwrap();
+        assert_eq!(faces, vec![1, 1, 2], "a quad's two triangles come from f statement 1");
     }
 
     #[test]

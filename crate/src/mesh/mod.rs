@@ -23,11 +23,11 @@ mod tests;
 
 pub use decimate::{decimate_interior, Decimated};
 pub use geometry::{wrap_angle, FaceFrames};
-pub use problem::Problem;
+pub use problem::{ElementNames, FileNames, LocatedProblem, Problem};
 pub use raw::RawMesh;
 pub use subdivide::subdivide_midpoint;
 pub use trimesh::{Outgoing, TriMesh, NONE};
-pub use validate::{analyze, analyze_by_index, ZERO_AREA_REL};
+pub use validate::{analyze, analyze_by_index, analyze_located, Located, ZERO_AREA_REL};
 pub use weld::{weld, Welded, NO_VERTEX};
 pub(crate) use topology::UnionFind;
 

@@ -17,7 +17,9 @@
 
 use super::topology::{he_head, he_tail, EdgeTable, UnionFind};
 use super::weld::{close_cracks, weld, Welded, NO_VERTEX};
+use super::problem::{FileNames, LocatedProblem};
 use super::{MeshReport, RawMesh};
+use crate::io::FileNumbering;
 use crate::Problem;
 
 /// Relative tolerance of the zero-area test: a face is flagged when
@@ -29,6 +31,23 @@ pub const ZERO_AREA_REL: f64 = 1e-12;
 /// reported, not fatal.
 pub fn analyze(raw: &RawMesh) -> MeshReport {
     analyze_raw(raw).report
+}
+
+/// What [`analyze_located`] finds: the report, the welding the problems'
+/// ids refer to, and every problem located and named as the file does.
+pub struct Located {
+    pub report: MeshReport,
+    pub welded: Welded,
+    pub problems: Vec<LocatedProblem>,
+}
+
+/// Like [`analyze`], with the welding and each problem as a
+/// [`LocatedProblem`] whose message follows the file's `numbering`.
+pub fn analyze_located(raw: &RawMesh, numbering: &FileNumbering) -> Located {
+    let Analysis { welded, report, .. } = analyze_raw(raw);
+    let names = FileNames { raw, welded: &welded, numbering };
+    let problems = report.problems.iter().map(|p| LocatedProblem::new(p, &names)).collect();
+    Located { report, welded, problems }
 }
 
 /// Welds `raw` by position, closes floating-point cracks along open

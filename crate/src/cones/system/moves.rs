@@ -229,8 +229,9 @@ impl ComponentSystem<'_> {
     /// the first-order change ([`Self::move_potential`]) and the two most
     /// promising per cone are evaluated exactly; after the first pass only
     /// cones within two rings of a moved cone are reconsidered. Returns the
-    /// moves made.
-    pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
+    /// moves made; `progress(pass, tried, cones)` hears of each batch of
+    /// candidate cones evaluated.
+    pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize, usize, usize)) -> Result<usize, ConeError> {
         const EXACT_TRIES: usize = 2;
         let mut moves = 0;
         let mut current = self.phi_norm2();
@@ -238,7 +239,7 @@ impl ComponentSystem<'_> {
         // Cones to (re)consider: all at first, then those near a moved cone.
         let mut dirty = vec![true; nv];
         for pass in 0..max_passes {
-            progress(pass);
+            progress(pass, 0, 0);
             let potential = self.move_potential()?;
             // Per dirty interior cone: its index and its best candidates.
             let mut plans: Vec<(usize, i64, Vec<usize>)> = Vec::new();
@@ -266,7 +267,8 @@ impl ComponentSystem<'_> {
             dirty.iter_mut().for_each(|d| *d = false);
             let mut moved = 0;
             let per_solve = (self.trial_columns() / EXACT_TRIES).max(1);
-            for chunk in plans.chunks(per_solve) {
+            for (n, chunk) in plans.chunks(per_solve).enumerate() {
+                progress(pass, n * per_solve, plans.len());
                 let sets: Vec<Vec<Transfer>> =
                     chunk.iter().flat_map(|(i, ki, js)| js.iter().map(move |&j| vec![(*i, j, *ki)])).collect();
                 let dx = self.responses(&sets)?;
@@ -437,8 +439,9 @@ impl ComponentSystem<'_> {
     /// paper's clean-up to distant pairs): for each interior cone, tries
     /// cancelling it against each of its `nearest` closest cones of opposite
     /// index and keeps the best cancellation while the objective decreases.
-    /// Returns the number of pairs removed.
-    pub fn cancel_pairs(&mut self, nearest: usize, progress: &mut dyn FnMut(usize)) -> Result<usize, ConeError> {
+    /// Returns the number of pairs removed; `progress(removed, tried,
+    /// trials)` hears of each batch of candidate pairs evaluated.
+    pub fn cancel_pairs(&mut self, nearest: usize, progress: &mut dyn FnMut(usize, usize, usize)) -> Result<usize, ConeError> {
         let mut removed = 0;
         let mut current = self.objective();
         // Global candidate: when the interior indices sum to zero, all cones
@@ -456,7 +459,7 @@ impl ComponentSystem<'_> {
             }
         }
         loop {
-            progress(removed);
+            progress(removed, 0, 0);
             let cones = self.interior_cones();
             let pos = |i: usize| self.mesh.position(self.tree.vertices[i]);
             // Each pair is tried once, from its positive cone.
@@ -472,7 +475,9 @@ impl ComponentSystem<'_> {
             }
             let mut best: Option<(f64, Transfer, Vec<f64>)> = None;
             let dim = self.response_width();
-            for chunk in trials.chunks(self.trial_columns()) {
+            let per_solve = self.trial_columns();
+            for (n, chunk) in trials.chunks(per_solve).enumerate() {
+                progress(removed, n * per_solve, trials.len());
                 let sets: Vec<Vec<Transfer>> = chunk.iter().map(|&t| vec![t]).collect();
                 let dx = self.responses(&sets)?;
                 for (c, &t) in chunk.iter().enumerate() {
