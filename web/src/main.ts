@@ -6,6 +6,7 @@ import { Editor } from './editor';
 import { fetchFile, orderFiles, readFiles } from './files';
 import { Panels, type Sample, type Stats } from './panels';
 import type { Stage, WireFile } from './protocol';
+import { SplitPane } from './split';
 import { PageStore, mirrorToDataset } from './state';
 import { installHooks } from './test-hooks';
 import { Viewer } from './viewer';
@@ -17,6 +18,7 @@ const hooks = installHooks(store);
 mirrorToDataset(store, document.body.dataset);
 
 const panels = new Panels();
+new SplitPane($('views'), $('uv-divider'), $('uv-view'));
 const viewer = new Viewer($('viewport'));
 const worker = new MeshWorker();
 const editor = new Editor(viewer, worker, store, hooks);
@@ -171,6 +173,7 @@ window.__conemapTest = {
   edgeEnds: (e) => editor.features.edgeEnds(e),
   setQuadCount: (n) => editor.quads.setCount(n),
   projectUvFace: (f) => editor.results.projectUvFace(f),
+  projectUvPoint: (u, v) => editor.results.projectUvPoint(u, v),
 };
 
 void listSamples();
