@@ -6,6 +6,7 @@ import { $, fmtInt } from './dom';
 import { FeatureSet } from './features';
 import { COLORS } from './palette';
 import type { ImportResult } from './protocol';
+import { onClick } from './render-loop';
 import type { Hooks } from './test-hooks';
 import { type Adjacency, shortestPath } from './topology';
 import type { Viewer } from './viewer';
@@ -143,18 +144,7 @@ export class FeatureEditor {
   }
 
   private wirePicking(): void {
-    const canvas = this.viewer.canvas;
-    let down: { x: number; y: number; t: number } | null = null;
-    canvas.addEventListener('pointerdown', (e) => {
-      down = e.button === 0 ? { x: e.clientX, y: e.clientY, t: performance.now() } : null;
-    });
-    canvas.addEventListener('pointerup', (e) => {
-      if (!down || e.button !== 0) return;
-      const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
-      const quick = performance.now() - down.t < 600;
-      down = null;
-      if (moved < 5 && quick) this.click(e.clientX, e.clientY, e.shiftKey);
-    });
+    onClick(this.viewer.canvas, (e) => this.click(e.clientX, e.clientY, e.shiftKey));
   }
 
   private async applySharp(): Promise<void> {

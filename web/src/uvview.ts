@@ -10,7 +10,7 @@ import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
 import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
 import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
 import { COLORS, checkerTexture } from './palette';
-import { RenderLoop, createRenderer, latestPerFrame } from './render-loop';
+import { RenderLoop, createRenderer, latestPerFrame, onClick } from './render-loop';
 import { gridLines, gridStride } from './uv-grid';
 import { type UvOverlap, overlapText, overlapTint, uvOverlap } from './uv-overlap';
 
@@ -38,9 +38,6 @@ export interface UvDrawn {
 /** The unit square the seamless map is drawn against (texture space). */
 const UNIT_FRAME: [number, number, number, number] = [0, 0, 1, 1];
 
-/** A click moves the pointer less than this (CSS px) and lasts less than CLICK_MS; otherwise it is a pan. */
-const CLICK_PX = 5;
-const CLICK_MS = 600;
 
 /** A UV layout to show (see `SolveView` in protocol.ts); the arrays are used as they are (not copied). */
 export interface UvLayout {
@@ -140,15 +137,8 @@ export class UvView {
       if (!e.buttons) hoverAt(e);
     });
     canvas.addEventListener('pointerleave', () => this.onHover?.(null));
-    let down: { x: number; y: number; t: number } | null = null;
-    canvas.addEventListener('pointerdown', (e) => {
-      down = e.button === 0 ? { x: e.clientX, y: e.clientY, t: performance.now() } : null;
-    });
-    canvas.addEventListener('pointerup', (e) => {
-      if (!down || e.button !== 0) return;
-      const click = Math.hypot(e.clientX - down.x, e.clientY - down.y) < CLICK_PX && performance.now() - down.t < CLICK_MS;
-      down = null;
-      if (click && this.mesh) this.onSelect?.(this.pick(e.clientX, e.clientY));
+    onClick(canvas, (e) => {
+      if (this.mesh) this.onSelect?.(this.pick(e.clientX, e.clientY));
     });
     const toggle = container.querySelector<HTMLInputElement>('[data-uv=overlaps]');
     toggle?.addEventListener('change', () => this.setOverlapTint(toggle.checked));
@@ -262,12 +252,8 @@ export class UvView {
 
   /** Highlights the faces `faces` of the layout (the selected chart); null or none removes the highlight. Returns the faces highlighted. */
   setSelectedFaces(faces: Uint32Array | null): number {
-    if (this.selection) {
-      this.scene.remove(this.selection);
-      this.selection.geometry.dispose();
-      (this.selection.material as THREE.Material).dispose();
-      this.selection = null;
-    }
+    if (this.selection) drop(this.scene, this.selection);
+    this.selection = null;
     const uv = this.uv;
     const ids = uv && faces ? Array.from(faces).filter((f) => 6 * f + 5 < uv.length) : [];
     if (uv && ids.length > 0) {
@@ -295,14 +281,8 @@ export class UvView {
   /** Removes the layout shown. */
   clear(): void {
     this.setSelectedFaces(null);
-    for (const o of [this.mesh, this.edges, this.seams, this.frameLines, this.tint, ...this.grid]) {
-      if (!o) continue;
-      this.scene.remove(o);
-      o.geometry.dispose();
-      const m = o.material as THREE.Material & { map?: THREE.Texture | null };
-      if (o === this.tint) m.map?.dispose();
-      m.dispose();
-    }
+    if (this.tint) ((this.tint.material as THREE.MeshBasicMaterial).map)?.dispose();
+    for (const o of [this.mesh, this.edges, this.seams, this.frameLines, this.tint, ...this.grid]) if (o) drop(this.scene, o);
     this.mesh = null;
     this.edges = null;
     this.seams = null;
@@ -344,11 +324,7 @@ export class UvView {
     const pxPerCell = (this.size.h * this.camera.zoom) / (this.camera.top - this.camera.bottom);
     const stride = gridStride(pxPerCell);
     if (stride === d.gridStride) return;
-    for (const o of this.grid) {
-      this.scene.remove(o);
-      o.geometry.dispose();
-      (o.material as THREE.Material).dispose();
-    }
+    for (const o of this.grid) drop(this.scene, o);
     this.grid = [];
     d.gridStride = stride;
     if (stride !== null) {
@@ -462,6 +438,13 @@ export class UvView {
     this.updateGrid();
     this.loop.request();
   }
+}
+
+/** Takes `o` out of `scene` and frees its geometry and material (not the material's textures). */
+function drop(scene: THREE.Scene, o: THREE.Mesh | THREE.LineSegments): void {
+  scene.remove(o);
+  o.geometry.dispose();
+  (o.material as THREE.Material).dispose();
 }
 
 /** The outline of the rectangle `rect` ([min u, min v, max u, max v]) at height `z`, in the frame colour. */
