@@ -195,9 +195,15 @@ describe('UV pane', () => {
 
   it('draws the [0, 1]² frame and finds no overlap on a flat disk (recomputed from the OBJ)', async () => {
     const h = await hooks();
-    assert.deepEqual(h.uvView.frame, [0, 0, 1, 1]);
     assert.equal(h.uvView.map, 'seamless');
-    const truth = sampledOverlap(await downloadObj());
+    // The frame is the square the exports map to [0, 1]²: from the layout's lower-left corner, its longer side long.
+    const [u0, v0, u1, v1] = h.result.uvBounds;
+    const side = Math.max(u1 - u0, v1 - v0);
+    assert.deepEqual(h.uvView.frame, [u0, v0, u0 + side, v0 + side]);
+    const obj = await downloadObj();
+    const vts = obj.vt.flat();
+    assert.ok(Math.min(...vts) > -1e-6 && Math.abs(Math.max(...vts) - 1) < 1e-6, 'the OBJ spans [0, 1]² along its longer side');
+    const truth = sampledOverlap(obj);
     assert.equal(truth.share, 0, 'the OBJ of woody has no stacked UVs');
     assert.equal(h.uvView.overlap.overlapped, 0);
     assert.equal(h.uvView.overlap.maxDepth, 1);
@@ -207,7 +213,7 @@ describe('UV pane', () => {
 
   it('shows the overlap of a layout that overlaps, as recomputed from the OBJ, and tints it', async () => {
     await page.getByTestId('free-boundary').uncheck();
-    await loadSample(OVERLAPPING);
+    await loadSample('fandisk.obj');
     const h = await runSolve();
     const o = h.uvView.overlap;
     const truth = sampledOverlap(await downloadObj());

@@ -43,7 +43,9 @@ export class SplitPane {
     private readonly divider: HTMLElement,
     private readonly secondary: HTMLElement,
   ) {
-    new ResizeObserver(() => this.layout()).observe(area);
+    const observer = new ResizeObserver(() => this.layout());
+    observer.observe(area);
+    observer.observe(divider); // shown with the UV pane: its size counts
     this.wireDrag();
     divider.addEventListener('keydown', (e) => this.key(e));
     this.layout();
@@ -54,15 +56,22 @@ export class SplitPane {
     return this.share;
   }
 
-  /** Sets the UV pane's share (limited, see `clampShare`) and applies it. */
+  /** Sets the UV pane's share of the area beside the divider (limited, see `clampShare`) and applies it. */
   setShare(share: number): void {
-    const total = this.axis === 'row' ? this.area.clientWidth : this.area.clientHeight;
+    const { total, bar } = this.extent();
     this.share = clampShare(share, total);
-    this.secondary.style.flexBasis = `${(this.share * 100).toFixed(2)}%`;
+    this.secondary.style.flexBasis = `calc((100% - ${bar}px) * ${this.share.toFixed(4)})`;
     const least = Math.round(clampShare(1, total) === 0.5 ? 50 : (MIN_PANE_PX / total) * 100);
     this.divider.setAttribute('aria-valuemin', String(least));
     this.divider.setAttribute('aria-valuemax', String(100 - least));
     this.divider.setAttribute('aria-valuenow', String(Math.round((1 - this.share) * 100)));
+  }
+
+  /** The length (CSS px) along the axis shared by the two panes, and the divider's. */
+  private extent(): { total: number; bar: number } {
+    const row = this.axis === 'row';
+    const bar = row ? this.divider.offsetWidth : this.divider.offsetHeight;
+    return { total: (row ? this.area.clientWidth : this.area.clientHeight) - bar, bar };
   }
 
   /** Picks the axis for the area's current size and applies the share. */
@@ -88,8 +97,10 @@ export class SplitPane {
     });
     d.addEventListener('pointermove', (e) => {
       if (!d.hasPointerCapture(e.pointerId)) return;
+      // The divider's middle follows the pointer.
       const r = this.area.getBoundingClientRect();
-      this.setShare(this.axis === 'row' ? (r.right - e.clientX) / r.width : (r.bottom - e.clientY) / r.height);
+      const { total, bar } = this.extent();
+      this.setShare(((this.axis === 'row' ? r.right - e.clientX : r.bottom - e.clientY) - bar / 2) / total);
     });
     const end = (e: PointerEvent): void => {
       if (d.hasPointerCapture(e.pointerId)) d.releasePointerCapture(e.pointerId);

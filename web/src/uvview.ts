@@ -1,6 +1,6 @@
 // The 2D UV layout beside the 3D view: the parametrized triangles in an
 // orthographic view (pan and zoom, no rotation), coloured by distortion when
-// known, the [0, 1]² frame, the overlapping areas tinted (see uv-overlap.ts),
+// known, the [0, 1]² frame of the exports' texture space, the overlapping areas tinted (see uv-overlap.ts),
 // the hovered face outlined and ringed in sync with the 3D view, the selected
 // chart highlighted (a click picks a face, see chart-select.ts); an
 // integer-grid map (quad mode) with its grid lines (see uv-grid.ts).
@@ -23,7 +23,8 @@ export type UvOverlapFigures = Pick<UvOverlap, 'share' | 'maxDepth' | 'covered' 
 /**
  * What the view draws (for the test hooks): the map, the bounds of the drawn
  * triangles, the grid-line stride in cells (null: no grid lines), the
- * [0, 1]² frame ([min u, min v, max u, max v]; null on a grid map), the
+ * [0, 1]² frame of the exports (see `unitTile`; [min u, min v, max u, max v] in
+ * the layout's units; null on a grid map), the
  * overlap figures and whether their tint is drawn.
  */
 export interface UvDrawn {
@@ -35,8 +36,15 @@ export interface UvDrawn {
   overlapTint: boolean;
 }
 
-/** The unit square the seamless map is drawn against (texture space). */
-const UNIT_FRAME: [number, number, number, number] = [0, 0, 1, 1];
+/**
+ * The square the exports (OBJ, glTF) map to [0, 1]² for a seamless layout of
+ * bounds `b` ([min u, min v, max u, max v]): from the lower-left corner, as
+ * long as the longer side (crate `UvNormalization`).
+ */
+export function unitTile(b: readonly [number, number, number, number]): [number, number, number, number] {
+  const side = Math.max(b[2] - b[0], b[3] - b[1]);
+  return [b[0], b[1], b[0] + side, b[1] + side];
+}
 
 
 /** A UV layout to show (see `SolveView` in protocol.ts); the arrays are used as they are (not copied). */
@@ -107,7 +115,12 @@ export class UvView {
     this.controls.enableRotate = false;
     this.controls.screenSpacePanning = true;
     this.controls.mouseButtons = { LEFT: THREE.MOUSE.PAN, MIDDLE: THREE.MOUSE.DOLLY, RIGHT: THREE.MOUSE.PAN };
+    // A pan or zoom by the user (a change between start and end) ends the fit.
+    let interacting = false;
+    this.controls.addEventListener('start', () => (interacting = true));
+    this.controls.addEventListener('end', () => (interacting = false));
     this.controls.addEventListener('change', () => {
+      if (interacting) this.fitted = false;
       this.updateGrid();
       this.loop.request();
     });
@@ -191,7 +204,9 @@ export class UvView {
     const t0 = performance.now();
     const overlap = uvOverlap(uv);
     const { share, maxDepth, covered, overlapped, width, height } = overlap;
-    const frame = layout.map === 'seamless' ? UNIT_FRAME : null;
+    const frame = layout.map === 'seamless' && corners > 0 ? unitTile(layout.bounds) : null;
+    // Fit shows the whole texture square.
+    if (frame) this.bounds.expandByPoint(new THREE.Vector2(frame[2], frame[3]));
     this.drawn = {
       map: layout.map, bounds: [box.min.x, box.min.y, box.max.x, box.max.y], gridStride: null, frame,
       overlap: { share, maxDepth, covered, overlapped, width, height, ms: performance.now() - t0 }, overlapTint: false,
@@ -221,8 +236,10 @@ export class UvView {
       this.edges = new THREE.LineSegments(lg, new THREE.LineBasicMaterial({ color: 0x111720, transparent: true, opacity: 0.35 }));
       this.scene.add(this.edges);
     }
-    if (frame) this.frameLines = frameLines(frame, 0.003);
-    if (this.frameLines) this.scene.add(this.frameLines);
+    if (frame) {
+      this.frameLines = frameLines(frame, 0.003);
+      this.scene.add(this.frameLines);
+    }
     if (overlapped > 0) {
       this.tint = tintMesh(overlap, 0.004);
       this.scene.add(this.tint);
@@ -269,7 +286,7 @@ export class UvView {
       g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
       g.computeBoundingSphere();
       this.selection = new THREE.Mesh(g, new THREE.MeshBasicMaterial({
-        color: COLORS.selection, transparent: true, opacity: 0.55, side: THREE.DoubleSide, depthWrite: false,
+        color: COLORS.selection, transparent: true, opacity: 0.45, side: THREE.DoubleSide, depthWrite: false,
       }));
       this.selection.renderOrder = 6;
       this.scene.add(this.selection);
@@ -298,17 +315,25 @@ export class UvView {
     this.loop.request();
   }
 
-  /** Fits the view to the layout's bounds. */
+  /** Fits the view to the layout's bounds (and its texture square); it stays fit through resizes until the user pans or zooms. */
   frame(): void {
     if (this.bounds.isEmpty()) return;
     const c = this.bounds.getCenter(new THREE.Vector2());
-    const s = this.bounds.getSize(new THREE.Vector2());
     this.controls.target.set(c.x, c.y, 0);
     this.camera.position.set(c.x, c.y, 5);
     this.camera.zoom = 1;
-    this.span = Math.max(s.x, s.y, 1e-9) * 0.55;
+    this.fitted = true;
     this.resize();
     this.controls.update();
+  }
+
+  /** Whether the view is as `frame` left it (no pan or zoom since). */
+  private fitted = false;
+
+  /** Half the height (layout units) the camera shows at zoom 1: the bounds fit with a 10 % margin at aspect `aspect`. */
+  private fitSpan(aspect: number): number {
+    const s = this.bounds.getSize(new THREE.Vector2());
+    return Math.max(s.y, s.x / aspect, 1e-9) * 0.55;
   }
 
   private span = 1;
@@ -427,6 +452,7 @@ export class UvView {
       (this.hoverOutline.material as LineMaterial).resolution.set(w, h);
     }
     const aspect = w / h;
+    if (this.fitted && !this.bounds.isEmpty()) this.span = this.fitSpan(aspect);
     const c = this.controls.target;
     this.camera.left = -this.span * aspect;
     this.camera.right = this.span * aspect;
@@ -440,11 +466,14 @@ export class UvView {
   }
 }
 
-/** Takes `o` out of `scene` and frees its geometry and material (not the material's textures). */
-function drop(scene: THREE.Scene, o: THREE.Mesh | THREE.LineSegments): void {
+/** Takes `o` out of `scene` and frees the geometries and materials of it and its children (not the materials' textures). */
+function drop(scene: THREE.Scene, o: THREE.Object3D): void {
   scene.remove(o);
-  o.geometry.dispose();
-  (o.material as THREE.Material).dispose();
+  o.traverse((c) => {
+    const m = c as THREE.Mesh;
+    m.geometry?.dispose();
+    (m.material as THREE.Material | undefined)?.dispose();
+  });
 }
 
 /** The outline of the rectangle `rect` ([min u, min v, max u, max v]) at height `z`, in the frame colour. */
@@ -455,6 +484,10 @@ function frameLines(rect: readonly [number, number, number, number], z: number):
   g.setAttribute('position', new THREE.BufferAttribute(seg, 3));
   const lines = new THREE.LineSegments(g, new THREE.LineBasicMaterial({ color: COLORS.uvFrame, transparent: true, opacity: 0.8 }));
   lines.renderOrder = 1;
+  // The square itself a shade lighter than the background, behind the layout.
+  const fill = new THREE.Mesh(new THREE.PlaneGeometry(u1 - u0, v1 - v0), new THREE.MeshBasicMaterial({ color: 0x2a313c }));
+  fill.position.set((u0 + u1) / 2, (v0 + v1) / 2, -0.01);
+  lines.add(fill);
   return lines;
 }
 
@@ -470,7 +503,7 @@ function tintMesh(o: UvOverlap, z: number): THREE.Mesh {
   const g = new THREE.PlaneGeometry(u1 - u0, v1 - v0);
   g.translate((u0 + u1) / 2, (v0 + v1) / 2, z);
   const mesh = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ map: texture, transparent: true, depthWrite: false }));
-  mesh.renderOrder = 5;
+  mesh.renderOrder = 7; // over the selection: overlaps stay visible in a selected chart
   return mesh;
 }
 
