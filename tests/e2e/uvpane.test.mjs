@@ -95,7 +95,7 @@ function sampledOverlap({ vt, faces }, n = 400) {
   return { share: covered ? stacked / covered : 0, maxDepth };
 }
 
-/** The charts of the OBJ (faces joined across an edge whose two ends have the same UVs on both sides): the chart size of each face. */
+/** The charts of the OBJ (faces joined across an edge whose two ends have the same UVs on both sides): their count and the chart size of each face. */
 function objChartSizes({ v, vt, faces }) {
   const parent = faces.map((_, i) => i);
   const find = (i) => (parent[i] === i ? i : (parent[i] = find(parent[i])));
@@ -114,7 +114,7 @@ function objChartSizes({ v, vt, faces }) {
   });
   const size = new Map();
   faces.forEach((_, i) => size.set(find(i), (size.get(find(i)) ?? 0) + 1));
-  return faces.map((_, i) => size.get(find(i)));
+  return { count: size.size, sizes: faces.map((_, i) => size.get(find(i))) };
 }
 
 /** Clicks the UV view at the centroid of face `f`; returns the chart hook after it. */
@@ -213,7 +213,7 @@ describe('UV pane', () => {
 
   it('shows the overlap of a layout that overlaps, as recomputed from the OBJ, and tints it', async () => {
     await page.getByTestId('free-boundary').uncheck();
-    await loadSample('fandisk.obj');
+    await loadSample('teapot.obj');
     const h = await runSolve();
     const o = h.uvView.overlap;
     const truth = sampledOverlap(await downloadObj());
@@ -232,16 +232,22 @@ describe('UV pane', () => {
   });
 
   it('selects a clicked chart in both views (its face count recomputed from the OBJ); a click on empty space clears', async () => {
-    const sizes = objChartSizes(await downloadObj());
+    // The teapot: 4 components, so 4 charts of different sizes.
+    const { count, sizes } = objChartSizes(await downloadObj());
     const faces = sizes.length;
+    assert.ok(count > 1, 'the teapot has several charts');
     // Faces spread over the mesh, in charts of different sizes where there are several.
     const picks = [0, Math.floor(faces / 3), Math.floor((2 * faces) / 3), faces - 1];
+    const seen = new Set();
     for (const f of picks) {
       const chart = await clickUvFace(f);
       assert.ok(chart, `clicking face ${f} selected nothing`);
       assert.equal(chart.faces3d, sizes[chart.face], `3D: the chart of face ${chart.face}`);
       assert.equal(chart.facesUv, sizes[chart.face], `UV view: the chart of face ${chart.face}`);
+      assert.equal(chart.charts, count);
+      seen.add(chart.chart);
     }
+    assert.ok(seen.size > 1, 'clicks in different charts');
     await screenshot('uvpane-chart-selected');
     // Empty space: beyond the layout's bounds.
     const b = (await hooks()).uvView.bounds;
