@@ -1,6 +1,7 @@
 // A finished solve on screen: the figures table, the cones, seams and checker
 // (or distortion) surface in the 3D view, the UV layout beside it with hover in
-// sync (the seamless map, or the integer-grid map while quads are shown), the
+// sync (the seamless map, or the integer-grid map while quads are shown; its
+// overlap as a figure, a chart clicked there selected in both views), the
 // surface-mode switch with the distortion legend, and the downloads (glTF,
 // OBJ, the JSON report); the quads of the map are quad-panel.ts.
 import * as THREE from 'three';

@@ -2,8 +2,8 @@
 // they share is wider than tall, stacked otherwise (narrow windows, phones),
 // with a divider between them that sets the UV pane's share of the area: drag
 // it, or focus it and use the arrow keys (Shift: finer steps), Home and End
-// (the limits) — the ARIA window-splitter pattern, its value being the 3D
-// view's share in percent.
+// (the limits), double-click it for the default split — the ARIA
+// window-splitter pattern, its value being the 3D view's share in percent.
 
 /** Which way the panes are laid out: side by side ('row') or stacked ('column'). */
 export type SplitAxis = 'row' | 'column';
@@ -48,6 +48,7 @@ export class SplitPane {
     observer.observe(divider); // shown with the UV pane: its size counts
     this.wireDrag();
     divider.addEventListener('keydown', (e) => this.key(e));
+    divider.addEventListener('dblclick', () => this.setShare(DEFAULT_SHARE));
     this.layout();
   }
 
