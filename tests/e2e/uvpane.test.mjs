@@ -249,6 +249,10 @@ describe('UV pane', () => {
     }
     assert.ok(seen.size > 1, 'clicks in different charts');
     await screenshot('uvpane-chart-selected');
+    // Escape clears the selection too.
+    await page.keyboard.press('Escape');
+    assert.equal((await hooks()).chart, null);
+    await clickUvFace(0);
     // Empty space: beyond the layout's bounds.
     const b = (await hooks()).uvView.bounds;
     const p = await page.evaluate((bb) => window.__conemapTest.projectUvPoint(bb[2] + 0.02 * (bb[2] - bb[0]), bb[3] + 0.02 * (bb[3] - bb[1])), b);

@@ -1,6 +1,6 @@
 // Chart selection: a click on a chart (a connected UV island, see charts.ts)
 // in the UV view selects it in both views (its faces highlighted in 3D and in
-// the layout); a click on empty space or a new map clears it. The charts of a result are found on the first click.
+// the layout); a click on empty space, Escape or a new map clears it. The charts of a result are found on the first click.
 import { type Charts, chartFaces, faceCharts } from './charts';
 import type { Hooks } from './test-hooks';
 import type { UvView } from './uvview';
@@ -17,13 +17,16 @@ export class ChartSelection {
   private source: ChartSource | null = null;
   private charts: Charts | null = null;
 
-  /** Selects in `viewer` and `uvView` on clicks in `uvView`; keeps `hooks.chart` up to date. */
+  /** Selects in `viewer` and `uvView` on clicks in `uvView` (Escape clears); keeps `hooks.chart` up to date. */
   constructor(
     private readonly viewer: Viewer,
     private readonly uvView: UvView,
     private readonly hooks: Pick<Hooks, 'chart'>,
   ) {
     uvView.onSelect = (face) => this.selectFace(face);
+    window.addEventListener('keydown', (e) => {
+      if (e.key === 'Escape' && this.hooks.chart) this.selectFace(null);
+    });
   }
 
   /** Takes the map shown (null: none); clears the selection. */
