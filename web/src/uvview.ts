@@ -204,9 +204,8 @@ export class UvView {
     const t0 = performance.now();
     const overlap = uvOverlap(uv);
     const { share, maxDepth, covered, overlapped, width, height } = overlap;
+    // Drawn, not fit to: on a long layout most of the square is empty.
     const frame = layout.map === 'seamless' && corners > 0 ? unitTile(layout.bounds) : null;
-    // Fit shows the whole texture square.
-    if (frame) this.bounds.expandByPoint(new THREE.Vector2(frame[2], frame[3]));
     this.drawn = {
       map: layout.map, bounds: [box.min.x, box.min.y, box.max.x, box.max.y], gridStride: null, frame,
       overlap: { share, maxDepth, covered, overlapped, width, height, ms: performance.now() - t0 }, overlapTint: false,
@@ -315,7 +314,7 @@ export class UvView {
     this.loop.request();
   }
 
-  /** Fits the view to the layout's bounds (and its texture square); it stays fit through resizes until the user pans or zooms. */
+  /** Fits the view to the layout's bounds; it stays fit through resizes until the user pans or zooms. */
   frame(): void {
     if (this.bounds.isEmpty()) return;
     const c = this.bounds.getCenter(new THREE.Vector2());
