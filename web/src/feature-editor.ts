@@ -8,8 +8,8 @@ import { $, fmtInt } from './dom';
 import { download, fileStem } from './downloads';
 import { FeatureSet, type SharpSettings } from './features';
 import { COLORS } from './palette';
-import { latestPerFrame } from './render-loop';
 import type { ImportResult } from './protocol';
+import { latestPerFrame, onClick } from './render-loop';
 import type { Hooks } from './test-hooks';
 import { type Adjacency, shortestPath } from './topology';
 import type { Viewer } from './viewer';
@@ -210,20 +210,10 @@ export class FeatureEditor {
 
   private wirePicking(): void {
     const canvas = this.viewer.canvas;
-    let down: { x: number; y: number; t: number } | null = null;
     const hoverAt = latestPerFrame((e: PointerEvent) => this.hover(e.buttons === 0 && !e.shiftKey ? this.edgeFromPick(e.clientX, e.clientY) : -1));
     canvas.addEventListener('pointermove', hoverAt);
     canvas.addEventListener('pointerleave', () => requestAnimationFrame(() => this.hover(-1)));
-    canvas.addEventListener('pointerdown', (e) => {
-      down = e.button === 0 ? { x: e.clientX, y: e.clientY, t: performance.now() } : null;
-    });
-    canvas.addEventListener('pointerup', (e) => {
-      if (!down || e.button !== 0) return;
-      const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
-      const quick = performance.now() - down.t < 600;
-      down = null;
-      if (moved < 5 && quick) this.click(e.clientX, e.clientY, e.shiftKey);
-    });
+    onClick(canvas, (e) => this.click(e.clientX, e.clientY, e.shiftKey));
   }
 
   /**

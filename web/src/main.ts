@@ -6,6 +6,7 @@ import { Editor } from './editor';
 import { fetchFile, orderFiles, readFiles } from './files';
 import { Panels, type Sample, type Stats } from './panels';
 import type { Stage, WireFile } from './protocol';
+import { SplitPane } from './split';
 import { PageStore, mirrorToDataset } from './state';
 import { installHooks } from './test-hooks';
 import { wireViewKeys } from './view-keys';
@@ -18,6 +19,7 @@ const hooks = installHooks(store);
 mirrorToDataset(store, document.body.dataset);
 
 const panels = new Panels();
+new SplitPane($('views'), $('uv-divider'), $('uv-view'));
 const viewer = new Viewer($('viewport'));
 wireViewKeys(viewer);
 const worker = new MeshWorker();
@@ -179,6 +181,7 @@ window.__conemapTest = {
   setQuadCount: (n) => editor.quads.setCount(n),
   cameraTarget: () => viewer.target.toArray(),
   projectUvFace: (f) => editor.results.projectUvFace(f),
+  projectUvPoint: (u, v) => editor.results.projectUvPoint(u, v),
 };
 
 void listSamples();

@@ -16,6 +16,9 @@ export const COLORS = {
   anchor: 0xffffff,
   hover: 0xfff275,
   quadEdge: 0x2ad17a, // quad mesh edges (over the grid checker: apart from both of its colours)
+  selection: 0x38c8ff, // the selected chart, in both views
+  overlap: 0xb45cff, // UV areas stacked two or more layers deep
+  uvFrame: 0xc8d0dc, // the [0, 1]² frame of the UV view
 };
 
 /** The marker colour of a singular vertex of the quad mesh by valence: 3 and 5 as the cones of index +1 and −1 that make them. */

@@ -1,7 +1,7 @@
 // Rendering on demand, shared by the 3D view and the UV view: the renderer, a
 // render loop drawing at most once per animation frame (held while shaders
-// compile), pointer events coalesced to the latest one per frame, and a wait
-// for the next drawn frame.
+// compile), pointer events coalesced to the latest one per frame, clicks told
+// apart from drags, and a wait for the next drawn frame.
 import * as THREE from 'three';
 
 /** A WebGL renderer (antialiased, drawing buffer kept for screenshots, pixel ratio ≤ 2) whose canvas, with `data-testid` = `testid`, is appended to `container`. */
@@ -111,6 +111,24 @@ export function latestPerFrame<E>(handle: (e: E) => void): (e: E) => void {
     }
     pending = e;
   };
+}
+
+/** A click moves the pointer less than this (CSS px) and lasts less than CLICK_MS; otherwise it is a drag (orbit, pan). */
+const CLICK_PX = 5;
+const CLICK_MS = 600;
+
+/** Calls `handle` with the release of each left-button click on `el` (see CLICK_PX, CLICK_MS); drags call nothing. */
+export function onClick(el: HTMLElement, handle: (e: PointerEvent) => void): void {
+  let down: { x: number; y: number; t: number } | null = null;
+  el.addEventListener('pointerdown', (e) => {
+    down = e.button === 0 ? { x: e.clientX, y: e.clientY, t: performance.now() } : null;
+  });
+  el.addEventListener('pointerup', (e) => {
+    if (!down || e.button !== 0) return;
+    const click = Math.hypot(e.clientX - down.x, e.clientY - down.y) < CLICK_PX && performance.now() - down.t < CLICK_MS;
+    down = null;
+    if (click) handle(e);
+  });
 }
 
 /** Longest wait for an animation frame (hidden pages get none). */

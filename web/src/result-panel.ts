@@ -1,9 +1,11 @@
 // A finished solve on screen: the figures table, the cones, seams and checker
 // (or distortion) surface in the 3D view, the UV layout beside it with hover in
-// sync (the seamless map, or the integer-grid map while quads are shown), the
+// sync (the seamless map, or the integer-grid map while quads are shown; its
+// overlap as a figure, a chart clicked there selected in both views), the
 // surface-mode switch with the distortion legend, and the downloads (glTF,
 // OBJ, the JSON report); the quads of the map are quad-panel.ts.
 import * as THREE from 'three';
+import { ChartSelection } from './chart-select';
 import { $, definitionList, fmt, fmtInt, fmtMs } from './dom';
 import { download, downloadBytes, fileStem } from './downloads';
 import type { OpenMesh } from './feature-editor';
@@ -13,6 +15,7 @@ import type { QuadPanel } from './quad-panel';
 import { afterNextFrame, latestPerFrame } from './render-loop';
 import { buildSolveView, cutSegments, layoutGeometry, uvBounds } from './solve-view';
 import type { Hooks, ResultHook } from './test-hooks';
+import { overlapText } from './uv-overlap';
 import { type UvLayout, UvView } from './uvview';
 import type { SurfaceMode, Viewer } from './viewer';
 
@@ -28,6 +31,8 @@ export class ResultPanel {
   /** Bumped whenever the shown result is cleared: a view build that sees it change stops. */
   private epoch = 0;
   private readonly uvView: UvView;
+  /** The chart clicked in the UV view, selected in both views. */
+  private readonly charts: ChartSelection;
   /** The seamless map's layout of the result shown (null before it is on screen). */
   private seamless: UvLayout | null = null;
   private readonly el = {
@@ -46,12 +51,13 @@ export class ResultPanel {
   /** `quads` is told of every map shown and cleared. */
   constructor(
     private readonly viewer: Viewer,
-    private readonly hooks: Pick<Hooks, 'result' | 'hoverFace' | 'uvView'>,
+    private readonly hooks: Pick<Hooks, 'result' | 'hoverFace' | 'uvView' | 'chart'>,
     private readonly quads: QuadPanel,
   ) {
     this.uvView = new UvView(this.el.uv);
     this.uvView.onHover = (face) => this.hoverSync(face);
     this.uvView.onDrawn = (drawn) => (this.hooks.uvView = drawn);
+    this.charts = new ChartSelection(viewer, this.uvView, hooks);
     this.wireHover();
     this.wireControls();
   }
@@ -69,6 +75,7 @@ export class ResultPanel {
     this.hooks.result = null;
     this.el.results.hidden = true;
     this.el.uv.hidden = true;
+    this.charts.setMap(null);
     this.uvView.clear();
     this.viewer.setCones([], []);
     this.viewer.setLines('seams', new Uint32Array(0), [], COLORS.seam);
@@ -129,6 +136,9 @@ export class ResultPanel {
       };
       this.uvView.show(this.seamless);
       this.uvView.setColored(this.surfaceMode() === 'distortion');
+      this.charts.setMap({ faceEdges: m.data.faceEdges, edgeCount: m.edges.length / 2, seams: r.seam_edges ?? new Uint32Array(0) });
+      const overlapRow = definitionList([['UV overlap', overlapText(this.uvView.overlap!)]]);
+      this.el.resultStats.querySelector('dl')?.append(...overlapRow.childNodes);
       await this.uvView.loop.prepare();
       if (!live()) return false;
       await afterNextFrame();
@@ -159,11 +169,17 @@ export class ResultPanel {
       return;
     }
     this.uvView.setColored(this.surfaceMode() === 'distortion');
+    this.charts.reapply();
   }
 
   /** Page position (client CSS px) of the centroid of face `face` in the UV view and its farthest corner's distance; null when no layout is shown. */
   projectUvFace(face: number): { x: number; y: number; radius: number } | null {
     return this.uvView.projectFace(face);
+  }
+
+  /** Page position (client CSS px) of the layout point (u, v) in the UV view. */
+  projectUvPoint(u: number, v: number): { x: number; y: number } {
+    return this.uvView.projectPoint(u, v);
   }
 
   /** The report: settings, features, mesh figures and the solver's result (without bulky arrays); null without a result. */

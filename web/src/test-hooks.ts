@@ -87,6 +87,8 @@ export interface Hooks {
   hoverFace: number | null;
   /** What the UV view draws: which map, the bounds of its triangles, the grid-line stride (null when no layout is shown). */
   uvView: UvDrawn | null;
+  /** The chart selected by a click in the UV view: the face clicked, its chart, the chart count, the faces highlighted in 3D and in the layout (null: none). */
+  chart: { face: number; chart: number; charts: number; faces3d: number; facesUv: number } | null;
   /** Figures of the quads shown (null when none are). */
   quads: QuadsHook | null;
   /** Message of the last failed quads request (null after a success). */
@@ -122,6 +124,8 @@ export interface TestActions {
   cameraTarget(): [number, number, number];
   /** Page position (client CSS px) of the centroid of face `face` in the UV view, and the distance from it to the farthest corner; null when no layout is shown. */
   projectUvFace(face: number): { x: number; y: number; radius: number } | null;
+  /** Page position (client CSS px) of the layout point (u, v) in the UV view. */
+  projectUvPoint(u: number, v: number): { x: number; y: number };
 }
 
 declare global {
@@ -140,7 +144,7 @@ export function installHooks(store: PageStore): Hooks {
     },
     stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
     features: 0, hoverEdge: null, problemFocus: null, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
-    uvView: null, quads: null, quadsError: null, quadRuns: 0,
+    uvView: null, chart: null, quads: null, quadsError: null, quadRuns: 0,
   };
   window.__conemap = hooks;
   return hooks;

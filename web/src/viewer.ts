@@ -10,8 +10,9 @@ import { LineSegments2 } from 'three/examples/jsm/lines/LineSegments2.js';
 import { LineSegmentsGeometry } from 'three/examples/jsm/lines/LineSegmentsGeometry.js';
 import { COLORS, checkerTexture, coneColor, gridCheckerUv } from './palette';
 import type { Cone } from './protocol';
+import { localEdgeLengths, markerRadius } from './marker-size';
 import { RenderLoop, createRenderer } from './render-loop';
-import { edgeSegments } from './solve-view';
+import { cornerPositions, edgeSegments } from './solve-view';
 
 export interface MeshData {
   positions: Float32Array;
@@ -291,7 +292,11 @@ export class Viewer {
     this.loop.request();
   }
 
-  /** Cones as spheres coloured by index; boundary corners as small cubes. */
+  /**
+   * Cones as spheres coloured by index; boundary corners as small cubes. Each
+   * marker is sized by the edges around its vertex (see `markerRadius`), so
+   * that dense cones stay apart.
+   */
   setCones(cones: Cone[], corners: Cone[]): void {
     if (cones.length === 0 && corners.length === 0 && this.markers.children.length === 0) return;
     for (const child of [...this.markers.children]) {
@@ -302,23 +307,26 @@ export class Viewer {
     }
     const box = this.mesh?.geometry.boundingBox;
     const diagonal = box ? box.max.distanceTo(box.min) : 1;
-    const r = diagonal * 0.01;
     const place = (list: Cone[], geometry: THREE.BufferGeometry, colorOf: (c: Cone) => number): void => {
       if (list.length === 0) return;
+      const local = this.data ? localEdgeLengths(this.data.positions, this.data.indices, list.map((c) => c.vertex)) : null;
       const material = new THREE.MeshStandardMaterial({ roughness: 0.35, metalness: 0.1 });
       const im = new THREE.InstancedMesh(geometry, material, list.length);
       const m = new THREE.Matrix4();
       const color = new THREE.Color();
       list.forEach((c, i) => {
-        m.makeTranslation(c.position[0], c.position[1], c.position[2]);
+        const r = markerRadius(local?.[i] ?? NaN, diagonal);
+        m.makeScale(r, r, r).setPosition(c.position[0], c.position[1], c.position[2]);
         im.setMatrixAt(i, m);
         im.setColorAt(i, color.setHex(colorOf(c)));
       });
+      im.computeBoundingSphere();
       im.renderOrder = 5;
       this.markers.add(im);
     };
-    place(cones, new THREE.SphereGeometry(r, 20, 14), (c) => coneColor(c.k));
-    place(corners, new THREE.BoxGeometry(r * 1.7, r * 1.7, r * 1.7), () => COLORS.corner);
+    // Unit shapes, scaled per marker: a sphere of radius 1, a cube of side 1.7.
+    place(cones, new THREE.SphereGeometry(1, 20, 14), (c) => coneColor(c.k));
+    place(corners, new THREE.BoxGeometry(1.7, 1.7, 1.7), () => COLORS.corner);
     this.loop.request();
   }
 
@@ -393,6 +401,35 @@ export class Viewer {
     this.hover.geometry.computeBoundingSphere();
     this.hover.visible = true;
     this.loop.request();
+  }
+
+  /**
+   * Highlights the faces `faces` (ids of the shown mesh; the selected chart)
+   * over the surface; null or none removes the highlight. Returns the faces
+   * highlighted.
+   */
+  setSelectedFaces(faces: Uint32Array | null): number {
+    const n = this.data ? this.data.indices.length / 3 : 0;
+    const ids = faces ? Array.from(faces).filter((f) => f < n) : [];
+    if (ids.length === 0 || !this.data) {
+      this.setOverlay('selection', null);
+      return 0;
+    }
+    const { positions, indices } = this.data;
+    const corners = new Uint32Array(ids.length * 3);
+    ids.forEach((f, i) => corners.set(indices.subarray(3 * f, 3 * f + 3), 3 * i));
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(cornerPositions(positions, corners), 3));
+    g.computeBoundingSphere();
+    const material = new THREE.MeshBasicMaterial({
+      color: COLORS.selection, transparent: true, opacity: 0.5, side: THREE.DoubleSide, depthWrite: false,
+      // In front of the (offset-back) surface it lies on, hidden behind the rest of the mesh.
+      polygonOffset: true, polygonOffsetFactor: -1, polygonOffsetUnits: -2,
+    });
+    const mesh = new THREE.Mesh(g, material);
+    mesh.renderOrder = 4;
+    this.setOverlay('selection', mesh);
+    return ids.length;
   }
 
   /** Position of a mesh vertex on the page (CSS px, client coordinates); null when behind the camera. */
