@@ -244,6 +244,8 @@ export interface QuantizeReport {
   /** Integers moved by one to undo a collapse. */
   moved_integers: number;
   arap_iterations: number;
+  /** Fit weight of the faces around singular points in the pass kept (1: the plain fit; more where that folded the map). */
+  stiff_weight: number;
   /** The rounded map had flipped triangles and the untangler removed them all. */
   untangled: boolean;
   /** Forms left at a non-integer value (0 on success). */
@@ -318,7 +320,7 @@ export interface QuadsResult {
 
 export const QUANTIZE_REPORT_KEYS = {
   grid_size: true, point_forms: true, translation_forms: true, batches: true, separation_moves: true, separations: true,
-  separations_violated: true, moved_integers: true, arap_iterations: true,
+  separations_violated: true, moved_integers: true, arap_iterations: true, stiff_weight: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
   wound_vertices: true, cells: true, seconds: true,
 } as const satisfies Keys<QuantizeReport>;

@@ -97,6 +97,15 @@ const UNCOLLAPSE_PROBES: usize = 48;
 /// Relative residual of every solve.
 const SOLVE_TOLERANCE: f64 = 1e-12;
 
+/// Fit weights of the faces around singular points
+/// ([`Quantizer::stiff_faces`]) tried in turn while the map stays bad: 1 is
+/// the plain fit (the least distortion where it works), the others trade
+/// some distortion for maps that do not fold or wind near cones.
+const STIFF_WEIGHTS: [f64; 3] = [1.0, 10.0, 100.0];
+
+/// Radius (grid units) of the stiff faces around a singular point.
+const STIFF_RADIUS: f64 = 1.0;
+
 /// ARAP iterations after the rounding, at most.
 const ARAP_ITERATIONS: usize = 20;
 
@@ -204,6 +213,9 @@ pub struct QuantizeReport {
     pub moved_integers: usize,
     /// ARAP iterations kept after the rounding.
     pub arap_iterations: usize,
+    /// Fit weight of the faces around singular points in the pass kept (1:
+    /// the plain fit; more where that folded or wound the map).
+    pub stiff_weight: f64,
     /// The rounded map had flipped triangles and the untangler removed them all.
     pub untangled: bool,
     /// Forms that came out determined by others at a non-integer value (0 on success).
@@ -253,7 +265,6 @@ pub struct Quantizer {
     pins: Vec<[usize; 2]>,
     /// The seamless map's unknowns (model units).
     seamless: Vec<f64>,
-    stiffness: Vec<Triplet>,
     /// UV area of every face in the seamless map (model units).
     seamless_areas: Vec<f64>,
     /// Faces of the mesh (corner `k` of face `f` is unknown column `k` of element `f`).
@@ -328,7 +339,6 @@ impl Quantizer {
             angle_sums,
             seam_rows: seam_rows(mesh, &cut, &vars).rows,
             wedge: cut.wedge,
-            stiffness: stiffness_triplets(&elements, &vec![1.0; nf]),
             elements,
             vars,
             n_unknowns,
@@ -342,6 +352,48 @@ impl Quantizer {
             map_area,
             distortion_before: metrics::distortion(mesh, &param.uv),
         })
+    }
+
+    /// Faces within [`STIFF_RADIUS`] grid units (in the seamless map `x0`,
+    /// grid units) of a singular point, reached through faces of its chart:
+    /// a rounded point drags a fit of uniform weight along as a spike (a
+    /// harmonic displacement from one point decays within a ring), which
+    /// folds its ring or winds the map around a neighbour when the point
+    /// moves by more than the ring is wide; stiffer faces around it carry
+    /// the ring along and leave the distortion to the regular faces beyond.
+    fn stiff_faces(&self, x0: &[f64]) -> Vec<bool> {
+        let n_wedges = self.vars[0].len();
+        let mut elements_of: Vec<Vec<usize>> = vec![Vec::new(); n_wedges];
+        for (f, el) in self.elements.iter().enumerate() {
+            for &w in &el.w {
+                elements_of[w].push(f);
+            }
+        }
+        let uv = |w: usize| [x0[self.vars[0][w]], x0[self.vars[1][w]]];
+        let radius = STIFF_RADIUS;
+        let mut stiff = vec![false; self.elements.len()];
+        let mut seen = vec![usize::MAX; n_wedges];
+        for c in (0..n_wedges).filter(|&w| (0..2).all(|k| self.form_of[self.vars[k][w]] != usize::MAX)) {
+            let p = uv(c);
+            let near = |w: usize| {
+                let q = uv(w);
+                (q[0] - p[0]).hypot(q[1] - p[1]) < radius
+            };
+            let mut stack = vec![c];
+            seen[c] = c;
+            while let Some(w) = stack.pop() {
+                for &f in &elements_of[w] {
+                    stiff[f] = true;
+                    for &u in &self.elements[f].w {
+                        if seen[u] != c && near(u) {
+                            seen[u] = c;
+                            stack.push(u);
+                        }
+                    }
+                }
+            }
+        }
+        stiff
     }
 
     /// Grid cell length for `size` (model units).
@@ -372,104 +424,27 @@ impl Quantizer {
         let s = self.grid_length(size)?;
         let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
         let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
-        let mut values: Vec<Option<i64>> = vec![None; self.forms.len()];
-        let mut order: Vec<usize> = Vec::new();
-        let mut x = x0.clone();
-        let mut batches = 0;
-        let mut separation_moves = 0;
-        let mut system = None;
-        for kind in [FormKind::Cone, FormKind::Point, FormKind::Translation] {
-            loop {
-                let mut free: Vec<(f64, usize)> = (0..self.forms.len())
-                    .filter(|&i| values[i].is_none() && self.forms[i].kind == kind)
-                    .map(|i| (distance_to_integer(self.forms[i].value(&x)), i))
-                    .collect();
-                if free.is_empty() {
-                    break;
-                }
-                free.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                let near = free.iter().filter(|f| f.0 < NEAR_INTEGER).count();
-                let take = ((free.len() as f64 * BATCH_FRACTION).ceil() as usize)
-                    .max(near)
-                    .min(free.len());
-                let mut batch: Vec<usize> = free[..take].iter().map(|f| f.1).collect();
-                let before = order.len();
-                let mut retries = 0;
-                let (solved, dependent) = loop {
-                    for &i in &batch {
-                        values[i] = None;
-                    }
-                    for &i in &batch {
-                        values[i] = Some(self.rounding(i, &values, &x));
-                    }
-                    order.truncate(before);
-                    order.extend(&batch);
-                    let (solved, dependent) = self.solve(&order, &values, &x, &targets)?;
-                    // A candidate the others determine at a non-integer value (a
-                    // dependency with coefficient 1/2 the kind order missed): round
-                    // it first instead, so that it determines them.
-                    let conflicting: Vec<usize> = dependent
-                        .iter()
-                        .copied()
-                        .filter(|&i| {
-                            batch.contains(&i)
-                                && distance_to_integer(self.forms[i].value(&solved.x))
-                                    > NEAR_INTEGER
-                        })
-                        .collect();
-                    if conflicting.is_empty() || retries == MAX_REORDERS {
-                        break (solved, dependent);
-                    }
-                    retries += 1;
-                    batch.retain(|i| !conflicting.contains(i));
-                    batch.splice(0..0, conflicting);
-                };
-                let mut solved = solved;
-                separation_moves += self.separate(&mut solved, &mut values, &x0, &targets)?;
-                x = solved.x.clone();
-                // A candidate the batch's other forms already determine takes the
-                // value the solve gives it.
-                for i in dependent {
-                    values[i] = Some(self.forms[i].value(&x).round() as i64);
-                }
-                system = Some(solved);
-                batches += 1;
-                progress(
-                    values.iter().filter(|v| v.is_some()).count(),
-                    self.forms.len(),
-                );
+        // Rounded with the uniform fit, and where that leaves the map bad,
+        // again with the faces around singular points stiffer; the best is kept.
+        let stiff = self.stiff_faces(&x0);
+        let mut best: Option<Rounded> = None;
+        for (pass, &weight) in STIFF_WEIGHTS.iter().enumerate() {
+            if pass > 0 && (best.as_ref().is_some_and(|b| b.collapsed + b.wound == 0) || !stiff.contains(&true)) {
+                break;
+            }
+            let fit = Fit::new(&self.elements, &stiff, weight);
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, progress)?;
+            // Flipped or collapsed faces leave holes in the quad mesh; a cell
+            // the map winds around is closed with quads (an extra singular
+            // vertex): fewer of the first, then of the second, count first.
+            let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
+            let better = best.as_ref().is_none_or(|b| key(&rounded) < key(b));
+            if better {
+                best = Some(Rounded { stiff_weight: weight, ..rounded });
             }
         }
-        // The rounded map polished (untangled where it folds, then ARAP);
-        // where it is still bad, the same after moving integers off collapses,
-        // keeping whichever ends better.
-        let mut moved_integers = 0;
-        let (mut arap_iterations, mut untangled) = (0, false);
-        if let Some(mut moved_system) = system {
-            let (polished, bad, iterations, untangle_ok) =
-                self.polish(x.clone(), &moved_system, &targets, s)?;
-            let rounded = std::mem::replace(&mut x, polished);
-            (arap_iterations, untangled) = (iterations, untangle_ok);
-            if bad > 0 && UNCOLLAPSE_TRIALS > 0 {
-                let (mut moved_values, mut moved_x) = (values.clone(), rounded);
-                let moves = self.uncollapse(
-                    &mut moved_values,
-                    &mut moved_x,
-                    &mut moved_system,
-                    &x0,
-                    &targets,
-                    s,
-                )?;
-                if moves > 0 {
-                    let (polished, moved_bad, iterations, untangle_ok) =
-                        self.polish(moved_x, &moved_system, &targets, s)?;
-                    if moved_bad < bad {
-                        (x, arap_iterations, untangled, values, moved_integers) =
-                            (polished, iterations, untangle_ok, moved_values, moves);
-                    }
-                }
-            }
-        }
+        let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, .. } =
+            best.expect("at least one pass");
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
             if let (FormKind::Cone | FormKind::Point, [(i, 1)], Some(v)) =
@@ -516,6 +491,7 @@ impl Quantizer {
             separations_violated: self.violated_separations(&x).len(),
             moved_integers,
             arap_iterations,
+            stiff_weight,
             untangled,
             conflicts,
             integer_residual,
@@ -527,6 +503,135 @@ impl Quantizer {
             seconds: clock.lap(),
         };
         Ok(IntegerGridMap { uv, report })
+    }
+
+    /// One greedy rounding of all forms with the fit `fit` (batches of
+    /// [`BATCH_FRACTION`], each re-solved, separations restored), then
+    /// [`Self::polish`], and where the map is still bad [`Self::uncollapse`]
+    /// and polish again, keeping the better.
+    fn round_and_polish(
+        &self,
+        fit: &Fit,
+        x0: &[f64],
+        targets: &[[[f64; 2]; 2]],
+        s: f64,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<Rounded, QuantizeError> {
+        let x0 = x0.to_vec();
+        let mut values: Vec<Option<i64>> = vec![None; self.forms.len()];
+        let mut order: Vec<usize> = Vec::new();
+        let mut x = x0.clone();
+        let mut batches = 0;
+        let mut separation_moves = 0;
+        let mut system = None;
+        for kind in [FormKind::Cone, FormKind::Point, FormKind::Translation] {
+            loop {
+                let mut free: Vec<(f64, usize)> = (0..self.forms.len())
+                    .filter(|&i| values[i].is_none() && self.forms[i].kind == kind)
+                    .map(|i| (distance_to_integer(self.forms[i].value(&x)), i))
+                    .collect();
+                if free.is_empty() {
+                    break;
+                }
+                free.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                let near = free.iter().filter(|f| f.0 < NEAR_INTEGER).count();
+                let take = ((free.len() as f64 * BATCH_FRACTION).ceil() as usize)
+                    .max(near)
+                    .min(free.len());
+                let mut batch: Vec<usize> = free[..take].iter().map(|f| f.1).collect();
+                let before = order.len();
+                let mut retries = 0;
+                let (solved, dependent) = loop {
+                    for &i in &batch {
+                        values[i] = None;
+                    }
+                    for &i in &batch {
+                        values[i] = Some(self.rounding(i, &values, &x));
+                    }
+                    order.truncate(before);
+                    order.extend(&batch);
+                    let (solved, dependent) = self.solve(fit, &order, &values, &x, targets)?;
+                    // A candidate the others determine at a non-integer value (a
+                    // dependency with coefficient 1/2 the kind order missed): round
+                    // it first instead, so that it determines them.
+                    let conflicting: Vec<usize> = dependent
+                        .iter()
+                        .copied()
+                        .filter(|&i| {
+                            batch.contains(&i)
+                                && distance_to_integer(self.forms[i].value(&solved.x))
+                                    > NEAR_INTEGER
+                        })
+                        .collect();
+                    if conflicting.is_empty() || retries == MAX_REORDERS {
+                        break (solved, dependent);
+                    }
+                    retries += 1;
+                    batch.retain(|i| !conflicting.contains(i));
+                    batch.splice(0..0, conflicting);
+                };
+                let mut solved = solved;
+                separation_moves += self.separate(&mut solved, &mut values, &x0, targets)?;
+                x = solved.x.clone();
+                // A candidate the batch's other forms already determine takes the
+                // value the solve gives it.
+                for i in dependent {
+                    values[i] = Some(self.forms[i].value(&x).round() as i64);
+                }
+                system = Some(solved);
+                batches += 1;
+                progress(
+                    values.iter().filter(|v| v.is_some()).count(),
+                    self.forms.len(),
+                );
+            }
+        }
+        // The rounded map polished (untangled where it folds, then ARAP);
+        // where it is still bad, the same after moving integers off collapses,
+        // keeping whichever ends better.
+        let mut moved_integers = 0;
+        let (mut arap_iterations, mut untangled) = (0, false);
+        if let Some(mut moved_system) = system {
+            let (polished, bad, iterations, untangle_ok) =
+                self.polish(x.clone(), &moved_system, targets, s)?;
+            let rounded = std::mem::replace(&mut x, polished);
+            (arap_iterations, untangled) = (iterations, untangle_ok);
+            if bad > 0 && UNCOLLAPSE_TRIALS > 0 {
+                let (mut moved_values, mut moved_x) = (values.clone(), rounded);
+                let moves = self.uncollapse(
+                    &mut moved_values,
+                    &mut moved_x,
+                    &mut moved_system,
+                    &x0,
+                    targets,
+                    s,
+                )?;
+                if moves > 0 {
+                    let (polished, moved_bad, iterations, untangle_ok) =
+                        self.polish(moved_x, &moved_system, targets, s)?;
+                    if moved_bad < bad {
+                        (x, arap_iterations, untangled, values, moved_integers) =
+                            (polished, iterations, untangle_ok, moved_values, moves);
+                    }
+                }
+            }
+        }
+        let collapsed = (0..self.elements.len()).filter(|&f| self.collapsed(f, &x, s)).count();
+        let wound = self.wound_vertices(&x).len();
+        let distortion = self.fit_distortion(&x, targets);
+        Ok(Rounded { x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, collapsed, wound, distortion, stiff_weight: fit.stiff_weight })
+    }
+
+    /// Area-weighted mean of `|J_f - T_f|^2` over the faces (the fit's
+    /// objective with uniform weights), to compare maps of one grid size.
+    fn fit_distortion(&self, x: &[f64], targets: &[[[f64; 2]; 2]]) -> f64 {
+        let (mut sum, mut area) = (0.0, 0.0);
+        for (el, t) in self.elements.iter().zip(targets) {
+            let j = el.jacobian(x);
+            sum += el.area * (0..2).flat_map(|r| (0..2).map(move |c| (r, c))).map(|(r, c)| (j[r][c] - t[r][c]).powi(2)).sum::<f64>();
+            area += el.area;
+        }
+        sum / area
     }
 
     /// The integer form `i` is rounded to: the nearest, unless that puts a
@@ -895,6 +1000,7 @@ impl Quantizer {
     /// determine them.
     fn solve(
         &self,
+        fit: &Fit,
         order: &[usize],
         values: &[Option<i64>],
         x: &[f64],
@@ -943,9 +1049,10 @@ impl Quantizer {
                 b.push(v);
             }
         }
-        let kkt = Kkt::assemble(&self.stiffness, self.n_unknowns, &c, b.len())?;
+        let kkt = Kkt::assemble(&fit.stiffness, self.n_unknowns, &c, b.len())?;
         let solver = factored(&kkt)?;
         let mut system = RoundedSystem {
+            weights: fit.weights.clone(),
             solver,
             c,
             b,
@@ -956,6 +1063,41 @@ impl Quantizer {
         system.x = system.resolve(self, targets)?;
         Ok((system, dependent))
     }
+}
+
+/// The least-squares fit of the rounded map to the seamless map's
+/// Jacobians, `min sum_f w_f A_f |J_f - J_f^0 / s|^2`: per-face weights and
+/// the stiffness they give.
+struct Fit {
+    weights: Vec<f64>,
+    stiffness: Vec<Triplet>,
+    stiff_weight: f64,
+}
+
+impl Fit {
+    /// Weight `stiff_weight` on the faces `stiff`, 1 elsewhere.
+    fn new(elements: &[Element], stiff: &[bool], stiff_weight: f64) -> Fit {
+        let weights: Vec<f64> = stiff.iter().map(|&b| if b { stiff_weight } else { 1.0 }).collect();
+        let stiffness = stiffness_triplets(elements, &weights);
+        Fit { weights, stiffness, stiff_weight }
+    }
+}
+
+/// The outcome of one [`Quantizer::round_and_polish`].
+struct Rounded {
+    x: Vec<f64>,
+    values: Vec<Option<i64>>,
+    batches: usize,
+    separation_moves: usize,
+    moved_integers: usize,
+    arap_iterations: usize,
+    untangled: bool,
+    /// Collapsed or flipped faces ([`Quantizer::collapsed`]), wound
+    /// vertices and [`Quantizer::fit_distortion`] of `x`.
+    collapsed: usize,
+    wound: usize,
+    distortion: f64,
+    stiff_weight: f64,
 }
 
 /// One integer moved by [`Quantizer::separate`]: the row of `c` changed by
@@ -971,6 +1113,8 @@ struct SeparationMove {
 
 /// A factored KKT of [`Quantizer::solve`] and its constraint values.
 struct RoundedSystem {
+    /// Per face: the weight of its Jacobian fit ([`Fit`]).
+    weights: Vec<f64>,
     solver: LdltSolver,
     c: Vec<Triplet>,
     b: Vec<f64>,
@@ -1021,11 +1165,11 @@ impl RoundedSystem {
     /// The map closest to per-face target Jacobians `targets` under this system's rows.
     fn resolve(&self, q: &Quantizer, targets: &[[[f64; 2]; 2]]) -> Result<Vec<f64>, QuantizeError> {
         let mut rhs = vec![0.0; q.n_unknowns];
-        for (el, t) in q.elements.iter().zip(targets) {
+        for ((el, t), w) in q.elements.iter().zip(targets).zip(&self.weights) {
             for k in 0..3 {
                 let g = el.g[k];
                 for c in 0..2 {
-                    rhs[el.x[c][k]] += el.area * (g[0] * t[c][0] + g[1] * t[c][1]);
+                    rhs[el.x[c][k]] += w * el.area * (g[0] * t[c][0] + g[1] * t[c][1]);
                 }
             }
         }
