@@ -31,8 +31,18 @@
 //! [`Quantizer::uncollapse`] moves the integers at the bad triangles by one
 //! and the moved map is polished too; the better of the two is returned.
 //!
+//! The fit weighs every face alike first. A rounded singular point then
+//! drags the fit along as a spike (the displacement of a point constraint
+//! decays within a ring), which folds its ring or winds the map around a
+//! neighbour when the point moves by more than the ring is wide. Where that
+//! leaves the map bad, the whole rounding runs again with the faces within
+//! one grid unit of every singular point [`STIFF_WEIGHTS`] times stiffer, so
+//! the ring moves with its point; the pass with the fewest collapsed faces,
+//! then wound vertices, then the least fit distortion is kept.
+//!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
-//! batch (the rows change; about ten batches). With that factorization:
+//! batch (the rows change; about ten batches), and up to three passes where
+//! the plain fit leaves the map bad. With that factorization:
 //! one adjoint solve per violated separation and one solve per move tried
 //! (at most [`SEPARATION_TRIALS`] per batch); after the last batch, one
 //! adjoint solve per probed unknown and one solve per `uncollapse` trial
