@@ -7,7 +7,7 @@
 import assert from 'node:assert/strict';
 import path from 'node:path';
 import { after, before, describe, it } from 'node:test';
-import { closePage, openPage, output } from './harness.mjs';
+import { canvasRgba, closePage, openPage, output } from './harness.mjs';
 import { needleObj } from '../node/wasm.mjs';
 
 const LOAD_TIMEOUT = 90_000;
@@ -44,18 +44,10 @@ async function sharp(deg, count) {
 /** Pixels of the 3D view in the highlight colour (COLORS.problem, #b6ff00). */
 async function highlightPixels() {
   await nextFrame();
-  return page.evaluate(() => {
-    const src = document.querySelector('[data-testid=canvas]');
-    const c = document.createElement('canvas');
-    c.width = src.width;
-    c.height = src.height;
-    const g = c.getContext('2d');
-    g.drawImage(src, 0, 0);
-    const d = g.getImageData(0, 0, c.width, c.height).data;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) if (d[i] > 140 && d[i] < 225 && d[i + 1] > 215 && d[i + 2] < 90) n++;
-    return n;
-  });
+  const { data: d } = await canvasRgba(page, 'canvas');
+  let n = 0;
+  for (let i = 0; i < d.length; i += 4) if (d[i] > 140 && d[i] < 225 && d[i + 1] > 215 && d[i + 2] < 90) n++;
+  return n;
 }
 
 /** True when vertex `v` projects inside the 3D view. */

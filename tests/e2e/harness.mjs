@@ -31,3 +31,20 @@ export async function closePage(ctx) {
   await ctx?.browser?.close();
   await ctx?.server?.close();
 }
+
+/** The pixels of the canvas with test id `testid` on `page` as drawn now: { width, height, data } (RGBA bytes). */
+export async function canvasRgba(page, testid) {
+  const { width, height, base64 } = await page.evaluate((id) => {
+    const src = document.querySelector(`[data-testid=${id}]`);
+    const c = document.createElement('canvas');
+    c.width = src.width;
+    c.height = src.height;
+    const g = c.getContext('2d');
+    g.drawImage(src, 0, 0);
+    const bytes = g.getImageData(0, 0, c.width, c.height).data;
+    let s = '';
+    for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+    return { width: c.width, height: c.height, base64: btoa(s) };
+  }, testid);
+  return { width, height, data: new Uint8Array(Buffer.from(base64, 'base64')) };
+}

@@ -22,6 +22,14 @@ export const fmtBytes = (n: number): string =>
 /** A duration in milliseconds, rounded: "12 ms". */
 export const fmtMs = (ms: number): string => `${ms.toFixed(0)} ms`;
 
+/** A duration for people: "640 ms" below a second, "3.2 s" below 100 s, "123 s" above; '—' when not finite. */
+export const fmtDuration = (ms: number): string =>
+  !Number.isFinite(ms) ? '—' : ms < 1000 ? fmtMs(ms) : ms < 100_000 ? `${(ms / 1000).toFixed(1)} s` : `${(ms / 1000).toFixed(0)} s`;
+
+/** α_smooth as shown (fewer decimals for larger values). */
+export const fmtAlpha = (a: number): string =>
+  a >= 10 ? a.toFixed(0) : a >= 1 ? a.toFixed(2) : a >= 0.01 ? a.toFixed(3) : a.toExponential(1);
+
 /** A two-column table of figures; each value carries `data-stat` (its key in kebab case). */
 export function definitionList(rows: Array<[string, string]>): HTMLDListElement {
   const table = document.createElement('dl');

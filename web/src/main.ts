@@ -19,7 +19,7 @@ mirrorToDataset(store, document.body.dataset);
 const panels = new Panels();
 const viewer = new Viewer($('viewport'));
 const worker = new MeshWorker();
-const editor = new Editor(viewer, worker, store, hooks);
+const editor = new Editor(viewer, worker, store, hooks, (text) => panels.setStatus(text, false));
 
 const stageText: Record<Stage, string> = {
   starting: 'Starting the importer',
