@@ -185,6 +185,11 @@ export class ResultPanel {
     this.uvView.setColored(this.surfaceMode() === 'distortion');
   }
 
+  /** Scrolls the panel as little as needed to bring the surface switch and the downloads into view (after a fresh solve). */
+  revealActions(): void {
+    this.el.glb.parentElement?.scrollIntoView({ block: 'nearest' });
+  }
+
   /** Page position (client CSS px) of the centroid of face `face` in the UV view and its farthest corner's distance; null when no layout is shown. */
   projectUvFace(face: number): { x: number; y: number; radius: number } | null {
     return this.uvView.projectFace(face);

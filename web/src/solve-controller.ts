@@ -159,6 +159,7 @@ export class SolveController {
       this.hooks.solveError = null;
       this.hooks.solveErrorLocation = null;
       this.history.add(outcome.run);
+      this.results.revealActions();
       const { result: r, settings } = outcome.run;
       this.setStatus(`Solved in ${fmtDuration(settings.wall_ms)} (α ${fmtAlpha(settings.alpha_smooth)}): ${fmtInt(r.cones.length)} cones, distortion ${fmt(r.metrics.distortion)}`);
     } else if (outcome.kind === 'failed') {
