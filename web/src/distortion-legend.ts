@@ -7,13 +7,16 @@ import { $, fmt } from './dom';
 import { rampGradient } from './palette';
 import { rampCss } from './solve-view';
 
-/** The share of the histogram's width its last bar (≥ scale) takes, apart from the others. */
-const OVERFLOW_WIDTH = 0.14;
+/** The share of the histogram's width its last bar (≥ scale) takes, apart from the others (also the ramp's and the labels'). */
+const OVERFLOW_WIDTH = 0.16;
+/** The colour of the histogram's bars up to the scale (the ramp above them keys the colours); the last bar has the ramp's top colour. */
+const BAR_COLOR = '#9aa9bf';
 
 export class DistortionLegend {
   /** Called when the scale changes (mode, or a valid fixed value). */
   onChange: (() => void) | null = null;
   private readonly el = {
+    box: $('distortion-legend'),
     mode: $<HTMLSelectElement>('distortion-scale-mode'),
     value: $<HTMLInputElement>('distortion-scale-value'),
     ramp: $('distortion-ramp'),
@@ -27,6 +30,7 @@ export class DistortionLegend {
   constructor() {
     const el = this.el;
     el.ramp.style.background = rampGradient(1 - OVERFLOW_WIDTH);
+    el.box.style.setProperty('--overflow-width', `${OVERFLOW_WIDTH * 100}%`);
     el.mode.addEventListener('change', () => {
       const fixed = el.mode.value === 'fixed';
       el.value.disabled = !fixed;
@@ -57,9 +61,9 @@ export class DistortionLegend {
     g.clearRect(0, 0, canvas.width, canvas.height);
     const span = canvas.width * (1 - OVERFLOW_WIDTH);
     const w = span / (bins - 1);
+    g.fillStyle = BAR_COLOR;
     for (let i = 0; i < bins - 1; i++) {
       const bar = (counts[i]! / top) * h;
-      g.fillStyle = rampCss((i + 0.5) / (bins - 1));
       g.fillRect(i * w + 0.5, canvas.height - bar, Math.max(w - 1, 1), bar);
     }
     // The last bar, apart: everything at or above the scale.
@@ -67,8 +71,6 @@ export class DistortionLegend {
     const over = (counts[bins - 1]! / top) * h;
     g.fillStyle = rampCss(1);
     g.fillRect(span + gap, canvas.height - over, canvas.width - span - gap, over);
-    g.fillStyle = 'rgba(139, 149, 165, 0.5)';
-    g.fillRect(span + gap / 2 - 0.5, 0, 1, canvas.height);
     const share = counts.reduce((s, c) => s + c, 0);
     canvas.setAttribute('aria-label', `Histogram of per-face distortion: ${counts[bins - 1]} of ${share} faces at or above ${fmt(max)}`);
   }

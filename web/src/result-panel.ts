@@ -365,7 +365,7 @@ function summaryFigures(run: Run, f: ResultHook): HTMLDivElement[] {
   const m = run.result.metrics;
   const items: Array<[string, string, string, string]> = [
     ['cones', 'Cones', fmtInt(f.cones), `(+${f.plus} / −${f.minus})`],
-    ['distortion', 'Distortion', fmt(m.distortion), 'mean, eq. 19'],
+    ['distortion', 'Distortion', fmt(m.distortion), 'mean'],
     ['flipped', 'Flipped faces', fmtInt(m.flipped), ''],
     ['time', 'Time', fmtDuration(run.settings.wall_ms), ''],
   ];
