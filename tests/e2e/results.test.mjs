@@ -222,12 +222,14 @@ describe('result panel, distortion scale and run history', () => {
   });
 
   it('clears the history when a new mesh opens', async () => {
+    const rows = page.getByTestId('run-history-rows').locator('tr');
+    assert.equal(await rows.count(), 2, 'two runs before');
     const n = (await hooks()).loads;
     const obj = 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n';
     await page.getByTestId('file-input').setInputFiles({ name: 'tetra.obj', mimeType: 'text/plain', buffer: Buffer.from(obj) });
     await page.waitForFunction((k) => window.__conemap.loads > k && window.__conemap.state !== 'loading', n, { timeout: LOAD_TIMEOUT });
     assert.equal((await hooks()).state, 'ready');
-    assert.equal(await page.getByTestId('run-history-rows').locator('tr').count(), 0);
+    assert.equal(await rows.count(), 0);
     assert.equal(await page.getByTestId('run-history').isVisible(), false);
     assert.equal(await page.getByTestId('results').isVisible(), false);
     assert.match(await page.getByTestId('status-text').innerText(), /^Loaded tetra\.obj/);
