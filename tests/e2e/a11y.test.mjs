@@ -1,8 +1,10 @@
 // Automated accessibility check of the whole page with axe-core, run in the
 // page: after load, with a mesh that cannot be solved (the problems list),
-// and after a solve (the results). No violation of contrast, labels, names
-// of buttons, progress bars and canvases, or of the rest of axe's WCAG A/AA
-// rules; and the focus ring of the file input shows on its button.
+// after a solve (the results), and with the run history, the open details,
+// a fixed distortion scale and the checker density shown. No violation of
+// contrast, labels, names of buttons, progress bars and canvases, or of the
+// rest of axe's WCAG A/AA rules; and the focus ring of the file input shows
+// on its button.
 import assert from 'node:assert/strict';
 import path from 'node:path';
 import { createRequire } from 'node:module';
@@ -64,6 +66,24 @@ describe('accessibility (axe-core)', () => {
     assert.match(tips['Seam length'], /length units/);
     assert.match(await page.getByTestId('cone-legend').locator('span[title]').first().getAttribute('title'), /cone of index k = \+1/);
     await page.screenshot({ path: path.join(output, 'a11y-solved.png') });
+  });
+
+  it('has no violations with the run history, the details, a fixed distortion scale and the checker density shown', async () => {
+    await page.getByTestId('alpha').fill('0');
+    assert.equal((await runSolve()).state, 'solved');
+    assert.equal(await page.getByTestId('run-history').isVisible(), true, 'two runs: the history table is shown');
+    await page.getByTestId('result-details').locator('summary').click();
+    await page.getByTestId('surface-distortion').check();
+    await page.getByTestId('distortion-scale-mode').selectOption('fixed');
+    assert.equal(await page.getByTestId('distortion-scale-value').isEnabled(), true);
+    assert.deepEqual(await violations(), []);
+    await page.getByTestId('surface-checker').check();
+    assert.equal(await page.getByTestId('checker-density').isVisible(), true);
+    assert.deepEqual(await violations(), []);
+    // The headline figures explain their jargon as the tables do.
+    assert.match(await page.getByTestId('result-summary').locator('dt', { hasText: 'Flipped faces' }).getAttribute('title'), /turned over/);
+    await page.screenshot({ path: path.join(output, 'a11y-history.png') });
+    await page.getByTestId('result-details').locator('summary').click();
   });
 
   it('fits the screen after a solve at 800×600 and 390×844: nothing below it is cut off', async () => {

@@ -32,6 +32,23 @@ export async function closePage(ctx) {
   await ctx?.server?.close();
 }
 
+/** The pixels of the canvas with test id `testid` on `page` as drawn now: { width, height, data } (RGBA bytes). */
+export async function canvasRgba(page, testid) {
+  const { width, height, base64 } = await page.evaluate((id) => {
+    const src = document.querySelector(`[data-testid=${id}]`);
+    const c = document.createElement('canvas');
+    c.width = src.width;
+    c.height = src.height;
+    const g = c.getContext('2d');
+    g.drawImage(src, 0, 0);
+    const bytes = g.getImageData(0, 0, c.width, c.height).data;
+    let s = '';
+    for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+    return { width: c.width, height: c.height, base64: btoa(s) };
+  }, testid);
+  return { width, height, data: new Uint8Array(Buffer.from(base64, 'base64')) };
+}
+
 /**
  * The helpers the tests of one page share: its test hooks, waiting for a load
  * (after `loads` loads) or a sample, a solve from Run, the next two frames,
@@ -64,20 +81,12 @@ export function pageHelpers(page, { loadTimeout = 90_000, solveTimeout = 120_000
     },
     async colourPixels([r0, r1], [g0, g1], [b0, b1]) {
       await nextFrame();
-      return page.evaluate((q) => {
-        const src = document.querySelector('[data-testid=canvas]');
-        const c = document.createElement('canvas');
-        c.width = src.width;
-        c.height = src.height;
-        const g = c.getContext('2d');
-        g.drawImage(src, 0, 0);
-        const d = g.getImageData(0, 0, c.width, c.height).data;
-        let n = 0;
-        for (let i = 0; i < d.length; i += 4) {
-          if (d[i] > q[0] && d[i] < q[1] && d[i + 1] > q[2] && d[i + 1] < q[3] && d[i + 2] > q[4] && d[i + 2] < q[5]) n++;
-        }
-        return n;
-      }, [r0, r1, g0, g1, b0, b1]);
+      const { data: d } = await canvasRgba(page, 'canvas');
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        if (d[i] > r0 && d[i] < r1 && d[i + 1] > g0 && d[i + 1] < g1 && d[i + 2] > b0 && d[i + 2] < b1) n++;
+      }
+      return n;
     },
   };
 }

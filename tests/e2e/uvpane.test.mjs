@@ -133,6 +133,16 @@ async function screenshot(name) {
   await page.screenshot({ path: path.join(output, `${name}.png`) });
 }
 
+/** The "UV overlap" row of the result's figures as a user reads it: in "All figures and timings", opened for it and folded again. */
+async function overlapFigure() {
+  const details = page.getByTestId('result-details');
+  await details.locator('summary').click();
+  assert.equal(await details.evaluate((el) => el.open), true);
+  const text = await details.locator('[data-testid=result-stats] dd[data-stat=uv-overlap]').innerText();
+  await details.locator('summary').click();
+  return text;
+}
+
 describe('UV pane', () => {
   before(async () => {
     ctx = await openPage();
@@ -208,7 +218,7 @@ describe('UV pane', () => {
     assert.equal(truth.share, 0, 'the OBJ of woody has no stacked UVs');
     assert.equal(h.uvView.overlap.overlapped, 0);
     assert.equal(h.uvView.overlap.maxDepth, 1);
-    assert.equal(await page.locator('[data-testid=result-stats] dd[data-stat=uv-overlap]').innerText(), 'none');
+    assert.equal(await overlapFigure(), 'none');
     assert.equal(await page.getByTestId('uv-overlap-text').innerText(), 'none');
   });
 
@@ -223,7 +233,7 @@ describe('UV pane', () => {
     assert.equal(o.maxDepth, truth.maxDepth, 'deepest stack');
     assert.ok(o.ms < 1000, `rasterized in ${o.ms} ms`);
     assert.equal(h.uvView.overlapTint, true);
-    const shown = await page.locator('[data-testid=result-stats] dd[data-stat=uv-overlap]').innerText();
+    const shown = await overlapFigure();
     assert.match(shown, new RegExp(`^${Math.round(o.share * 100)} % of area, up to ${o.maxDepth} layers$`));
     // The tint can be turned off and on.
     await page.getByTestId('uv-overlaps').locator('input').uncheck();
@@ -249,6 +259,15 @@ describe('UV pane', () => {
     }
     assert.ok(seen.size > 1, 'clicks in different charts');
     await screenshot('uvpane-chart-selected');
+    // Recolouring both views at another distortion scale keeps the selection.
+    const selected = (await hooks()).chart;
+    await page.getByTestId('surface-distortion').check();
+    await page.getByTestId('distortion-scale-mode').selectOption('fixed');
+    assert.equal((await hooks()).distortion.fixed, true);
+    assert.deepEqual((await hooks()).chart, selected);
+    assert.equal((await hooks()).uvView.selectedFaces, selected.facesUv, 'the chart stays highlighted in the layout');
+    await page.getByTestId('distortion-scale-mode').selectOption('auto');
+    await page.getByTestId('surface-checker').check();
     // Escape clears the selection too.
     await page.keyboard.press('Escape');
     assert.equal((await hooks()).chart, null);

@@ -1,7 +1,8 @@
 // Unit tests of the page's pure modules (web/src/topology.ts, features.ts,
 // solve-view.ts, state.ts, uv-grid.ts, dom.ts) and the pure functions of
-// quad-panel.ts and quad-view.ts: each is bundled by esbuild to an ES module
-// and imported, so the tests run the page's code itself, without a browser.
+// quad-panel.ts, quad-view.ts, run-history.ts and distortion-legend.ts: each is
+// bundled by esbuild to an ES module and imported, so the tests run the page's
+// code itself, without a browser.
 import { before, describe, it } from 'node:test';
 import assert from 'node:assert/strict';
 import { loadPageModule as load } from './wasm.mjs';
@@ -170,19 +171,51 @@ describe('solve-view.ts', () => {
   let topo;
   before(async () => { [sv, topo] = await Promise.all([load('solve-view'), load('topology')]); });
 
-  it('colours and bins the distortion against its 99th percentile', () => {
+  it('colours and bins the distortion against its 99th percentile, the last bin holding everything at or above it', () => {
     const per = Float32Array.from({ length: 200 }, (_, i) => i / 100);
     const d = sv.distortionView(per);
     const sorted = [...per].sort((a, b) => a - b);
     assert.equal(d.max, sorted[Math.floor(200 * 0.99)]);
+    assert.equal(sv.autoScale(per), d.max);
     assert.equal(d.histogram.length, sv.HISTOGRAM_BINS);
     assert.equal(d.histogram.reduce((a, b) => a + b, 0), per.length, 'every face in one bin');
+    assert.equal(d.histogram[sv.HISTOGRAM_BINS - 1], per.filter((v) => v >= d.max).length, 'the last bin: ≥ max');
     assert.equal(d.colors.length, 9 * per.length);
+  });
+
+  it('colours against a fixed scale: faces above it saturate, the same values colour alike whatever the other faces', () => {
+    const per = Float32Array.from({ length: 200 }, (_, i) => i / 100);
+    const d = sv.distortionView(per, 0.5);
+    assert.equal(d.max, 0.5);
+    assert.equal(d.histogram[sv.HISTOGRAM_BINS - 1], 150, 'faces 0.50 … 1.99 in the last bin');
+    assert.equal(d.histogram.reduce((a, b) => a + b, 0), 200);
+    // The same value gets the same colour in another result under the same fixed scale, not under the auto one.
+    const low = sv.distortionView(Float32Array.from([0.25, 0.01, 0.02]), 0.5);
+    assert.deepEqual([...low.colors.subarray(0, 3)], [...d.colors.subarray(9 * 25, 9 * 25 + 3)]);
+    const lowAuto = sv.distortionView(Float32Array.from([0.25, 0.01, 0.02]));
+    assert.notDeepEqual([...lowAuto.colors.subarray(0, 3)], [...d.colors.subarray(9 * 25, 9 * 25 + 3)]);
+    // A non-positive scale falls back to auto.
+    assert.equal(sv.distortionView(per, 0).max, sv.autoScale(per));
+  });
+
+  it('ramps sequentially (viridis): dark purple at 0 to yellow at 1, luminance rising, clamped, in linear light', () => {
     const rgb = [0, 0, 0];
-    sv.heatRgb(0, rgb, 0);
-    assert.deepEqual(rgb.map((x) => +x.toFixed(2)), [0.23, 0.45, 0.95]);
-    sv.heatRgb(7, rgb, 0); // clamped to 1
-    assert.deepEqual(rgb.map((x) => +x.toFixed(2)), [0.9, 0.2, 0.2]);
+    const lin = (c) => (c / 255 <= 0.04045 ? c / 255 / 12.92 : ((c / 255 + 0.055) / 1.055) ** 2.4);
+    sv.rampRgb(0, rgb, 0);
+    assert.deepEqual(rgb.map((x) => +x.toFixed(4)), [0x44, 0x01, 0x54].map((c) => +lin(c).toFixed(4)), '#440154');
+    sv.rampRgb(7, rgb, 0); // clamped to 1
+    assert.deepEqual(rgb.map((x) => +x.toFixed(4)), [0xfd, 0xe7, 0x25].map((c) => +lin(c).toFixed(4)), '#fde725');
+    sv.rampRgb(NaN, rgb, 0);
+    assert.deepEqual(rgb.map((x) => +x.toFixed(4)), [0x44, 0x01, 0x54].map((c) => +lin(c).toFixed(4)), 'NaN as 0');
+    let last = -1;
+    for (let i = 0; i <= 20; i++) {
+      sv.rampRgb(i / 20, rgb, 0);
+      const y = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+      assert.ok(y > last, `luminance rises at t = ${i / 20}`);
+      last = y;
+    }
+    assert.equal(sv.rampCss(0), '#440154');
+    assert.equal(sv.rampCss(2), '#fde725');
   });
 
   it('outlines the charts along seams and the boundary only', () => {
@@ -445,6 +478,14 @@ describe('dom.ts', () => {
     assert.equal(dom.fmtMs(12.4), '12 ms');
     assert.equal(dom.fmtMs(12.6), '13 ms');
     assert.equal(dom.fmtMs(0), '0 ms');
+    assert.equal(dom.fmtDuration(640.4), '640 ms');
+    assert.equal(dom.fmtDuration(3240), '3.2 s');
+    assert.equal(dom.fmtDuration(123_400), '123 s');
+    assert.equal(dom.fmtDuration(NaN), '—');
+    assert.equal(dom.fmtAlpha(1), '1.00');
+    assert.equal(dom.fmtAlpha(0.01), '0.010');
+    assert.equal(dom.fmtAlpha(0.001), '1.0e-3');
+    assert.equal(dom.fmtAlpha(31.6), '32');
   });
 
   it('keys table rows in kebab case', () => {
@@ -452,5 +493,46 @@ describe('dom.ts', () => {
     assert.equal(dom.statKey('Σk (cones + corners)'), 'k-cones-corners');
     assert.equal(dom.statKey('Faces < 0.2 / < 0.3'), 'faces-0-2-0-3');
     assert.equal(dom.statKey('Time: cones total'), 'time-cones-total');
+  });
+});
+
+describe('run-history.ts', () => {
+  let rh;
+  before(async () => { rh = await load('run-history'); });
+
+  it('keeps the newest runs: at most MAX_RUNS, within the byte budget, the newest always', () => {
+    const runs = Array.from({ length: 12 }, (_, i) => ({ n: 12 - i, bytes: 10 }));
+    const size = (r) => r.bytes;
+    assert.deepEqual(rh.keptRuns(runs, size).map((r) => r.n), [12, 11, 10, 9, 8, 7, 6, 5]);
+    assert.equal(rh.MAX_RUNS, 8);
+    assert.deepEqual(rh.keptRuns(runs, size, 8, 35).map((r) => r.n), [12, 11, 10], 'three fit 35 bytes');
+    assert.deepEqual(rh.keptRuns([{ n: 1, bytes: 100 }, { n: 0, bytes: 1 }], size, 8, 35).map((r) => r.n), [1], 'the newest is kept even over the budget');
+    assert.deepEqual(rh.keptRuns([], size), []);
+  });
+
+  it('counts the bytes of a result\'s arrays, display arrays included', () => {
+    const r = {
+      uv: new Float32Array(6), seam_edges: new Uint32Array(2), glb: new Uint8Array(100), obj: null,
+      metrics: { per_face_distortion: new Float32Array(1) },
+    };
+    assert.equal(rh.runBytes(r), 24 + 8 + 100 + 4);
+    r.view = {
+      cornerPositions: new Float32Array(9), checkerUv: new Float32Array(6), layoutPositions: new Float32Array(9),
+      cutSegments: new Float32Array(0), seamSegments: new Float32Array(0), distortion: { colors: new Float32Array(9) },
+    };
+    assert.equal(rh.runBytes(r), 136 + 4 * (9 + 6 + 9 + 9));
+  });
+});
+
+describe('distortion-legend.ts', () => {
+  let dl;
+  before(async () => { dl = await load('distortion-legend'); });
+
+  it('rounds a scale to two significant digits for the fixed value', () => {
+    assert.equal(dl.roundScale(0.41873), 0.42);
+    assert.equal(dl.roundScale(1.26), 1.3);
+    assert.equal(dl.roundScale(0.000123456), 0.00012);
+    assert.equal(dl.roundScale(0), 1);
+    assert.equal(dl.roundScale(NaN), 1);
   });
 });

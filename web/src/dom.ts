@@ -23,23 +23,37 @@ export const fmtBytes = (n: number): string =>
 /** A duration in milliseconds, rounded: "12 ms". */
 export const fmtMs = (ms: number): string => `${ms.toFixed(0)} ms`;
 
+/** A duration for people: "640 ms" below a second, "3.2 s" below 100 s, "123 s" above; '—' when not finite. */
+export const fmtDuration = (ms: number): string =>
+  !Number.isFinite(ms) ? '—' : ms < 1000 ? fmtMs(ms) : ms < 100_000 ? `${(ms / 1000).toFixed(1)} s` : `${(ms / 1000).toFixed(0)} s`;
+
+/** α_smooth as shown (fewer decimals for larger values). */
+export const fmtAlpha = (a: number): string =>
+  a >= 10 ? a.toFixed(0) : a >= 1 ? a.toFixed(2) : a >= 0.01 ? a.toFixed(3) : a.toExponential(1);
+
 /** A two-column table of figures; each value carries `data-stat` (its key in kebab case), each jargon label its plain words as tooltip. */
 export function definitionList(rows: Array<[string, string]>): HTMLDListElement {
   const table = document.createElement('dl');
   for (const [k, v] of rows) {
-    const dt = document.createElement('dt');
-    dt.textContent = k;
-    const tip = GLOSSARY[k];
-    if (tip) {
-      dt.title = tip;
-      dt.className = 'term';
-    }
+    const dt = termLabel(k);
     const dd = document.createElement('dd');
     dd.textContent = v;
     dd.dataset['stat'] = statKey(k);
     table.append(dt, dd);
   }
   return table;
+}
+
+/** A `dt` reading `label`; a jargon label carries its plain words (glossary.ts) as tooltip and the class `term`. */
+export function termLabel(label: string): HTMLElement {
+  const dt = document.createElement('dt');
+  dt.textContent = label;
+  const tip = GLOSSARY[label];
+  if (tip) {
+    dt.title = tip;
+    dt.className = 'term';
+  }
+  return dt;
 }
 
 /** The `data-stat` key of a table row label: lower case, runs of other characters as one '-', none at the ends. */

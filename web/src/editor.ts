@@ -19,8 +19,8 @@ export class Editor {
   readonly quads: QuadPanel;
   readonly solve: SolveController;
 
-  /** Wires the five parts to `viewer`, `worker`, the page's `store` and the test `hooks` they keep up to date. */
-  constructor(viewer: Viewer, worker: MeshWorker, store: PageStore, hooks: Hooks) {
+  /** Wires the five parts to `viewer`, `worker`, the page's `store`, the test `hooks` they keep up to date and the page's status line (`setStatus`). */
+  constructor(viewer: Viewer, worker: MeshWorker, store: PageStore, hooks: Hooks, setStatus: (text: string) => void) {
     this.problems = new MeshProblems(viewer, hooks);
     this.features = new FeatureEditor(viewer, worker, hooks, {
       onChange: () => this.solve.featuresChanged(),
@@ -32,7 +32,7 @@ export class Editor {
       onGridUv: (uv) => this.results.showGridUv(uv),
     });
     this.results = new ResultPanel(viewer, hooks, this.quads);
-    this.solve = new SolveController(viewer, worker, store, this.features, this.problems, this.results, hooks);
+    this.solve = new SolveController(viewer, worker, store, this.features, this.problems, this.results, hooks, setStatus);
   }
 
   /** Opens a freshly imported mesh (`data`, shown by the viewer, named `label`): its problems listed and drawn, no features, no result, no solve error. */

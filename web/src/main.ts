@@ -23,7 +23,7 @@ new SplitPane($('views'), $('uv-divider'), $('uv-view'));
 const viewer = new Viewer($('viewport'));
 wireViewKeys(viewer);
 const worker = new MeshWorker();
-const editor = new Editor(viewer, worker, store, hooks);
+const editor = new Editor(viewer, worker, store, hooks, (text) => panels.setStatus(text, false));
 
 const stageText: Record<Stage, string> = {
   starting: 'Starting the importer',

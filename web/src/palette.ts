@@ -1,7 +1,8 @@
 // The colours of the 3D and UV views: line and marker colours, the cone colour
-// by index, the distortion ramp as a three.js colour, and the checker texture.
+// by index, the distortion ramp as a CSS gradient, and the checker texture the
+// views share, with its density.
 import * as THREE from 'three';
-import { heatRgb } from './solve-view';
+import { rampCss } from './solve-view';
 
 export const COLORS = {
   feature: 0xff9f1c,
@@ -41,16 +42,33 @@ export function coneColor(k: number): number {
   return k === 1 ? COLORS.conePlus : k === -1 ? COLORS.coneMinus : COLORS.coneOther;
 }
 
-const heatScratch = [0, 0, 0];
-
-/** Distortion colour ramp (0 = none … 1 = strong): blue → white → red (see `heatRgb`), written to `out`. */
-export function heat(t: number, out: THREE.Color = new THREE.Color()): THREE.Color {
-  heatRgb(t, heatScratch, 0);
-  return out.setRGB(heatScratch[0]!, heatScratch[1]!, heatScratch[2]!);
+/**
+ * The distortion ramp (see `rampRgb`) as a CSS linear gradient from the left
+ * (0) to `end` of the width (the scale); beyond, after a gap, the top colour
+ * (the histogram's last bar: at or above the scale).
+ */
+export function rampGradient(end = 1): string {
+  const pct = (x: number): string => `${(x * 100).toFixed(1)}%`;
+  const stops = Array.from({ length: 9 }, (_, i) => `${rampCss(i / 8)} ${pct((i / 8) * end)}`);
+  if (end < 1) stops.push(`transparent ${pct(end)}`, `transparent ${pct(end + 0.02)}`, `${rampCss(1)} ${pct(end + 0.02)}`);
+  return `linear-gradient(90deg, ${stops.join(', ')})`;
 }
 
-/** A new CHECKER_SQUARES × CHECKER_SQUARES checkerboard texture, repeating. */
+/** Squares across the larger side of a seamless layout at checker repeat 1 (see `checkerUv` in solve-view.ts). */
+export const CHECKER_BASE_SQUARES = 20;
+
+/** The checker densities offered: squares across the larger side of the layout. */
+export const CHECKER_DENSITIES = [10, 20, 40, 80] as const;
+
+let checker: THREE.Texture | null = null;
+
+/**
+ * The CHECKER_SQUARES × CHECKER_SQUARES checkerboard texture, repeating: one
+ * texture for the 3D and the UV view (each renderer uploads it once), so that
+ * `setCheckerRepeat` changes both.
+ */
 export function checkerTexture(): THREE.Texture {
+  if (checker) return checker;
   const size = 256;
   const c = document.createElement('canvas');
   c.width = c.height = size;
@@ -67,5 +85,11 @@ export function checkerTexture(): THREE.Texture {
   t.wrapS = t.wrapT = THREE.RepeatWrapping;
   t.colorSpace = THREE.SRGBColorSpace;
   t.anisotropy = 4;
+  checker = t;
   return t;
+}
+
+/** Squares of the checker per square of its UVs (1: as the UVs were scaled); the views draw it at their next frame (a uniform, no upload). */
+export function setCheckerRepeat(repeat: number): void {
+  checkerTexture().repeat.set(repeat, repeat);
 }

@@ -1,22 +1,25 @@
 // The solve controls: α_smooth, MIQ (which sets α to the library's MIQ
 // default), free boundary, Run (off, with the reason, on a mesh that cannot
 // be solved) and Cancel (also Esc); a solve through the worker with its
-// progress line, handed to the result panel once the solver answers, and one
-// end for every solve (success, failure, cancel); the solve error box, with
-// the mesh elements it names highlighted in 3D.
-import { $, fmtInt } from './dom';
+// progress line, handed to the result panel once the solver answers and kept
+// in the run history (run-history.ts, whose rows show a run again), and one
+// end for every solve (success, failure, cancel), told on the page's status
+// line; the solve error box, with the mesh elements it names highlighted in
+// 3D.
+import { $, fmt, fmtAlpha, fmtDuration, fmtInt } from './dom';
 import type { FeatureEditor } from './feature-editor';
 import type { MeshProblems } from './mesh-problems';
 import { COLORS } from './palette';
 import type { ErrorLocation } from './protocol';
 import type { ResultPanel } from './result-panel';
+import { type Run, RunHistory, type RunSettings } from './run-history';
 import { type PageState, type PageStore, canTransition } from './state';
 import type { Hooks } from './test-hooks';
 import type { Viewer } from './viewer';
 import { Cancelled, LocatedError, type MeshWorker } from './worker-client';
 
 /** How a solve ended. */
-type Outcome = { kind: 'solved' } | { kind: 'cancelled' } | { kind: 'failed'; message: string; location: ErrorLocation | null };
+type Outcome = { kind: 'solved'; run: Run } | { kind: 'cancelled' } | { kind: 'failed'; message: string; location: ErrorLocation | null };
 
 /** α_smooth of the slider's position (a power of ten). */
 const alphaOf = (slider: number): number => 10 ** slider;
@@ -33,11 +36,6 @@ const KIND_WORDS: Record<string, string> = {
   index_out_of_range: 'faces with bad vertex indices',
 };
 
-/** α_smooth as shown beside the slider (fewer decimals for larger values). */
-function alphaText(a: number): string {
-  return a >= 10 ? a.toFixed(0) : a >= 1 ? a.toFixed(2) : a >= 0.01 ? a.toFixed(3) : a.toExponential(1);
-}
-
 export class SolveController {
   /** Solves started so far; `active` is the one running (null: none). */
   private runs = 0;
@@ -48,6 +46,8 @@ export class SolveController {
   private roundingStart = 0;
   /** The slider's position before MIQ emulation set it to the MIQ default (restored when unticked). */
   private alphaBeforeMiq: string | null = null;
+  /** The runs of the open mesh. */
+  private readonly history = new RunHistory((run) => void this.showRun(run));
   private readonly el = {
     alpha: $<HTMLInputElement>('alpha'),
     alphaValue: $<HTMLOutputElement>('alpha-value'),
@@ -71,10 +71,12 @@ export class SolveController {
     private readonly problems: MeshProblems,
     private readonly results: ResultPanel,
     private readonly hooks: Pick<Hooks, 'solveError' | 'solveErrorLocation' | 'errorHighlight' | 'solves'>,
+    /** Sets the page's status line (what happened last). */
+    private readonly setStatus: (text: string) => void,
   ) {
     const el = this.el;
     const showAlpha = (): void => {
-      el.alphaValue.textContent = alphaText(alphaOf(Number(el.alpha.value)));
+      el.alphaValue.textContent = fmtAlpha(alphaOf(Number(el.alpha.value)));
     };
     el.alpha.addEventListener('input', showAlpha);
     showAlpha();
@@ -110,9 +112,10 @@ export class SolveController {
     }
   }
 
-  /** Resets the error box, status and note for the mesh the feature editor has just opened; on a mesh that cannot be solved, says why Run is off. */
+  /** Resets the error box, status, note and run history for the mesh the feature editor has just opened; on a mesh that cannot be solved, says why Run is off. */
   meshChanged(): void {
     const valid = this.features.mesh?.data.valid ?? false;
+    this.history.clear();
     this.clearProblem();
     this.hooks.solveErrorLocation = null;
     this.el.error.hidden = true;
@@ -148,7 +151,7 @@ export class SolveController {
     const alpha = alphaOf(Number(this.el.alpha.value));
     const miq = this.el.miq.checked;
     const freeBoundary = this.el.freeBoundary.checked;
-    const settings = {
+    const settings: Omit<RunSettings, 'wall_ms'> = {
       alpha_smooth: alpha,
       miq,
       boundary: freeBoundary ? 'free' : 'aligned',
@@ -162,6 +165,7 @@ export class SolveController {
     this.clearProblem();
     this.roundingStart = 0;
     this.setProgress('starting');
+    this.setStatus(`Solving ${m.label} (α ${fmtAlpha(alpha)})…`);
     this.store.transition('solving');
     const t0 = performance.now();
     let outcome: Outcome;
@@ -172,8 +176,9 @@ export class SolveController {
       if (this.active !== run) return;
       this.store.transition('solving', { building: true });
       this.setProgress('building view');
-      const shown = await this.results.show(m, result, { ...settings, wall_ms: performance.now() - t0 });
-      outcome = shown ? { kind: 'solved' } : { kind: 'cancelled' };
+      const solved: Run = { n: this.history.nextNumber, mesh: m, result, settings: { ...settings, wall_ms: performance.now() - t0 } };
+      const shown = await this.results.show(solved);
+      outcome = shown ? { kind: 'solved', run: solved } : { kind: 'cancelled' };
     } catch (e) {
       if (e instanceof Cancelled) outcome = { kind: 'cancelled' };
       else outcome = { kind: 'failed', message: e instanceof Error ? e.message : String(e), location: e instanceof LocatedError ? e.location : null };
@@ -205,18 +210,46 @@ export class SolveController {
     if (outcome.kind === 'solved') {
       this.hooks.solveError = null;
       this.hooks.solveErrorLocation = null;
+      this.history.add(outcome.run);
+      const { result: r, settings } = outcome.run;
+      this.setStatus(`Solved in ${fmtDuration(settings.wall_ms)} (α ${fmtAlpha(settings.alpha_smooth)}): ${fmtInt(r.cones.length)} cones, distortion ${fmt(r.metrics.distortion)}`);
     } else if (outcome.kind === 'failed') {
       this.hooks.solveError = outcome.message;
       this.hooks.solveErrorLocation = outcome.location;
       this.showError(outcome.message, outcome.location);
+      this.setStatus('Solve failed: see the message under Solve.');
+    } else {
+      // A cancel while the view was built cleared the result shown: the newest run comes back (its map left the worker).
+      const latest = this.history.latest;
+      if (!this.results.hasResult && latest) {
+        this.history.setCurrent(latest);
+        void this.results.show(latest, false);
+      }
+      this.setStatus(this.results.hasResult ? 'Solve cancelled; the previous result is shown.' : 'Solve cancelled.');
     }
     this.hooks.solves++;
     this.store.transition(this.results.hasResult ? 'solved' : 'ready');
+    // Once the progress line is gone: the panel is as tall as it stays.
+    if (outcome.kind === 'solved') this.results.revealActions();
   }
 
-  /** The controls as `state` and the open mesh allow: Run when a solve may start, Cancel while one runs (until its view is built). */
+  /**
+   * Shows `run` of the history again (its figures, views and downloads) and
+   * says so on the status line; quads only for the newest run (the worker
+   * holds its map only). Ignored while a solve runs.
+   */
+  private async showRun(run: Run): Promise<void> {
+    if (this.store.state.phase !== 'solved') return;
+    this.history.setCurrent(run);
+    const newest = run === this.history.latest;
+    this.setStatus(`Showing run ${run.n} of ${this.history.nextNumber - 1} (α ${fmtAlpha(run.settings.alpha_smooth)})${newest ? '' : '; quads need the newest run'}.`);
+    await this.results.show(run, newest);
+  }
+
+  /** The controls as `state` and the open mesh allow: Run when a solve may start, Cancel while one runs (until its view is built); the history's rows only when solved. */
   private render(state: PageState): void {
     const solving = state.phase === 'solving';
+    this.history.setEnabled(state.phase === 'solved');
     this.el.run.disabled = !this.features.mesh?.data.valid || !canTransition(state.phase, 'solving');
     this.el.cancel.disabled = !solving || state.building;
     this.el.progress.hidden = !solving;

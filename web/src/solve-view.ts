@@ -3,26 +3,44 @@
 // outlines), built with tight loops over typed arrays. Pure functions without
 // three.js: the worker builds a `SolveView` right after the solve and transfers
 // it, so the page only uploads; the page can build one itself as a fallback.
+import { interpolateViridis } from 'd3-scale-chromatic';
 import type { SolveView } from './protocol';
 
-/** Bins of the distortion histogram. */
+/** Bins of the distortion histogram: HISTOGRAM_BINS − 1 equal bins over [0, max), the last one every face at or above max. */
 export const HISTOGRAM_BINS = 40;
 
-/** Distortion colour ramp (0 = none … 1 = strong, clamped): blue → white → red; writes r, g, b to out[o..o+2]. */
-export function heatRgb(t: number, out: { [i: number]: number }, o: number): void {
-  const x = Math.max(0, Math.min(1, t));
-  if (x < 0.5) {
-    const y = x * 2;
-    out[o] = 0.23 + 0.72 * y;
-    out[o + 1] = 0.45 + 0.5 * y;
-    out[o + 2] = 0.95;
-    return;
+/** Entries of the distortion ramp's table (`rampRgb` picks the nearest). */
+const RAMP_SIZE = 256;
+let rampTable: Float32Array | null = null;
+
+/** An sRGB channel (0..1) in linear light, as WebGL vertex colours are read. */
+const srgbToLinear = (c: number): number => (c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4);
+
+/**
+ * Distortion colour ramp (0 = none … 1 = at or above the scale, clamped):
+ * viridis, sequential and perceptually ordered (dark purple → teal →
+ * yellow, see `rampCss`), in linear light for vertex colours; writes r, g,
+ * b to out[o..o+2].
+ */
+export function rampRgb(t: number, out: { [i: number]: number }, o: number): void {
+  if (!rampTable) {
+    rampTable = new Float32Array(RAMP_SIZE * 3);
+    for (let i = 0; i < RAMP_SIZE; i++) {
+      const hex = Number.parseInt(interpolateViridis(i / (RAMP_SIZE - 1)).slice(1), 16);
+      rampTable[3 * i] = srgbToLinear(((hex >> 16) & 255) / 255);
+      rampTable[3 * i + 1] = srgbToLinear(((hex >> 8) & 255) / 255);
+      rampTable[3 * i + 2] = srgbToLinear((hex & 255) / 255);
+    }
   }
-  const y = (x - 0.5) * 2;
-  out[o] = 0.95 - 0.05 * y;
-  out[o + 1] = 0.95 - 0.75 * y;
-  out[o + 2] = 0.95 - 0.75 * y;
+  const x = t > 0 ? (t < 1 ? t : 1) : 0; // NaN → 0
+  const i = 3 * Math.round(x * (RAMP_SIZE - 1));
+  out[o] = rampTable[i]!;
+  out[o + 1] = rampTable[i + 1]!;
+  out[o + 2] = rampTable[i + 2]!;
 }
+
+/** The ramp's colour at `t` (0..1, clamped) as CSS (sRGB hex), for the legend and the histogram. */
+export const rampCss = (t: number): string => interpolateViridis(Math.max(0, Math.min(1, t)));
 
 /** UVs scaled for the checker texture: 20 squares across the layout's larger side (a new array). */
 export function checkerUv(uv: Float32Array): Float32Array {
@@ -51,24 +69,34 @@ export function cornerPositions(positions: Float32Array, indices: Uint32Array): 
   return out;
 }
 
-/** Scale (99th percentile, at least 1e-6), rgb per face corner and a histogram of per-face distortion. */
-export function distortionView(perFace: Float32Array): NonNullable<SolveView['distortion']> {
+/** The auto scale of per-face distortion `perFace`: its 99th percentile, at least 1e-6 (1 when empty). */
+export function autoScale(perFace: Float32Array): number {
+  if (perFace.length === 0) return 1;
   const sorted = Float32Array.from(perFace).sort();
-  const p99 = sorted[Math.min(sorted.length - 1, Math.floor(sorted.length * 0.99))] ?? 1;
-  const max = Math.max(p99, 1e-6);
+  return Math.max(sorted[Math.min(sorted.length - 1, Math.floor(sorted.length * 0.99))]!, 1e-6);
+}
+
+/**
+ * Per-face distortion `perFace` as colours against `scale` (the value shown
+ * as the ramp's top; default: `autoScale`): the scale, rgb per face corner,
+ * and the histogram (see HISTOGRAM_BINS; NaN in no bin).
+ */
+export function distortionView(perFace: Float32Array, scale?: number): NonNullable<SolveView['distortion']> {
+  const max = scale !== undefined && scale > 0 ? scale : autoScale(perFace);
   const colors = new Float32Array(perFace.length * 9);
   const rgb = [0, 0, 0];
   const histogram = new Uint32Array(HISTOGRAM_BINS);
+  const top = HISTOGRAM_BINS - 1;
   for (let f = 0; f < perFace.length; f++) {
     const v = perFace[f]!;
-    heatRgb(v / max, rgb, 0);
+    rampRgb(v / max, rgb, 0);
     for (let k = 0; k < 9; k += 3) {
       colors[9 * f + k] = rgb[0]!;
       colors[9 * f + k + 1] = rgb[1]!;
       colors[9 * f + k + 2] = rgb[2]!;
     }
-    // NaN lands on no bin (as an index it is ignored).
-    histogram[Math.min(HISTOGRAM_BINS - 1, Math.max(0, Math.floor((v / max) * HISTOGRAM_BINS)))]!++;
+    if (v >= max) histogram[top]!++;
+    else if (v >= 0) histogram[Math.floor((v / max) * top)]!++;
   }
   return { colors, max, histogram };
 }

@@ -31,6 +31,17 @@ export interface ResultHook {
   uvBounds: [number, number, number, number] | null;
 }
 
+/** The distortion colours of the result shown, as the tests read them. */
+export interface DistortionHook {
+  /** The value at the ramp's top (the auto 99th percentile or the fixed scale). */
+  scale: number;
+  fixed: boolean;
+  /** Faces per histogram bin (the last: at or above the scale). */
+  histogram: number[];
+  /** Mean vertex colour (linear rgb) over the faces. */
+  meanColor: [number, number, number];
+}
+
 /** Figures of the quads shown, as the tests read them. */
 export interface QuadsHook {
   /** The count asked for (the slider's) and the one the extractor made. */
@@ -75,6 +86,10 @@ export interface Hooks {
   problemFocus: { index: number; vertices: number[] } | null;
   /** Figures of the last finished solve (null before one, or after a new mesh). */
   result: ResultHook | null;
+  /** The distortion colours of the result shown (null without one, or without per-face distortion). */
+  distortion: DistortionHook | null;
+  /** Checker squares across the seamless layout's larger side (null while the grid map's checker is drawn). */
+  checkerSquares: number | null;
   /** Message of the last failed solve (null after a successful one). */
   solveError: string | null;
   /** The `location` of the last failed solve's error (null after a success, or when it names no mesh element). */
@@ -143,7 +158,8 @@ export function installHooks(store: PageStore): Hooks {
       return store.state.phase;
     },
     stats: null, lastError: null, version: null, workerRestarts: 0, loads: 0, timings: null,
-    features: 0, hoverEdge: null, problemFocus: null, result: null, solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
+    features: 0, hoverEdge: null, problemFocus: null, result: null, distortion: null, checkerSquares: null,
+    solveError: null, solveErrorLocation: null, errorHighlight: null, solves: 0, hoverFace: null,
     uvView: null, chart: null, quads: null, quadsError: null, quadRuns: 0,
   };
   window.__conemap = hooks;

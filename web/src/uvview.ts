@@ -25,7 +25,8 @@ export type UvOverlapFigures = Pick<UvOverlap, 'share' | 'maxDepth' | 'covered' 
  * triangles, the grid-line stride in cells (null: no grid lines), the
  * [0, 1]² frame of the exports (see `unitTile`; [min u, min v, max u, max v] in
  * the layout's units; null on a grid map), the
- * overlap figures and whether their tint is drawn.
+ * overlap figures, whether their tint is drawn, and the faces highlighted as
+ * the selected chart.
  */
 export interface UvDrawn {
   map: UvMap;
@@ -34,6 +35,7 @@ export interface UvDrawn {
   frame: [number, number, number, number] | null;
   overlap: UvOverlapFigures;
   overlapTint: boolean;
+  selectedFaces: number;
 }
 
 /**
@@ -209,6 +211,7 @@ export class UvView {
     this.drawn = {
       map: layout.map, bounds: [box.min.x, box.min.y, box.max.x, box.max.y], gridStride: null, frame,
       overlap: { share, maxDepth, covered, overlapped, width, height, ms: performance.now() - t0 }, overlapTint: false,
+      selectedFaces: 0,
     };
     this.mesh = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ side: THREE.DoubleSide }));
     this.scene.add(this.mesh);
@@ -289,6 +292,10 @@ export class UvView {
       }));
       this.selection.renderOrder = 6;
       this.scene.add(this.selection);
+    }
+    if (this.drawn && this.drawn.selectedFaces !== ids.length) {
+      this.drawn.selectedFaces = ids.length;
+      this.onDrawn?.({ ...this.drawn });
     }
     this.loop.request();
     return ids.length;
