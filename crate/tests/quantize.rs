@@ -232,6 +232,32 @@ fn stiffer_fit_around_cones_mends_coarse_grids() {
     assert!(r.angle_mean_deviation < 7.0, "fandisk: mean corner-angle deviation {}", r.angle_mean_deviation);
 }
 
+/// Where the coarse map winds twice around a point (fandisk > 60° at 1 000
+/// quads: three cells of 8 sides, each an isoline traced out and back plus
+/// a hexagon), the extractor closes the mesh instead of leaving holes: each
+/// hexagon becomes three quads around an input vertex, and the quad mesh is
+/// closed, manifold, one piece, with the input's Euler characteristic; the
+/// report says where.
+#[test]
+fn cells_the_map_winds_around_are_closed_with_quads() {
+    use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
+    let input = load("fandisk.obj");
+    let features = FeatureSet::sharp_edges(&input, 60.0);
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1000), &mut |_, _| {}).unwrap();
+    assert!(map.report.wound_vertices > 0, "the case this tests is gone: {:?}", map.report);
+    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
+    assert!(!quads.defects.is_empty());
+    for d in &quads.defects {
+        assert!(d.what.contains("closed") && !d.what.contains("skipped"), "{d:?}");
+    }
+    let r = check_quads(&solution.mesh, &quads, &CheckOptions::default());
+    assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (2, 0, 1), "{r:?}");
+    assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.unreferenced_vertices), (0, 0, 0), "{r:?}");
+    assert_eq!(quads.uv.len(), 4 * quads.quads.len());
+    assert!(r.distance_input_to_quads_relative.unwrap() < 0.01, "{r:?}");
+}
+
 /// The same quantizer serves a second grid size (the page re-runs only this
 /// stage when the quad count changes).
 #[test]

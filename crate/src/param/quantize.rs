@@ -44,7 +44,8 @@
 //! batch (the rows change; about ten batches), and up to three passes where
 //! the plain fit leaves the map bad. With that factorization:
 //! one adjoint solve per violated separation and one solve per move tried
-//! (at most [`SEPARATION_TRIALS`] per batch); after the last batch, one
+//! (at most [`SEPARATION_TRIALS`] per batch, fewer on large meshes:
+//! [`FULL_BUDGET_FACES`]); after the last batch, one
 //! adjoint solve per probed unknown and one solve per `uncollapse` trial
 //! (at most [`UNCOLLAPSE_TRIALS`], only where the map is bad), and one solve
 //! per ARAP iteration.
@@ -115,6 +116,27 @@ const STIFF_WEIGHTS: [f64; 3] = [1.0, 10.0, 100.0];
 
 /// Radius (grid units) of the stiff faces around a singular point.
 const STIFF_RADIUS: f64 = 1.0;
+
+/// The stiffer passes run only while the best map has at most this many
+/// collapsed faces and wound vertices: they mend a few bad places next to
+/// cones; where dense features fold the map in many places they cost two
+/// more roundings for little.
+const STIFF_PASS_LIMIT: usize = 16;
+
+/// Meshes up to this many faces get the full budgets of extra solves
+/// ([`SEPARATION_TRIALS`], [`UNCOLLAPSE_TRIALS`], [`UNCOLLAPSE_PROBES`] and
+/// the untangler's default iterations); larger ones a share `FULL_BUDGET_FACES
+/// / faces` of them (at least [`MIN_BUDGET_SHARE`]), since each solve costs
+/// in proportion: on a 114 k-face mesh with dense lone features the full
+/// budgets spent 85 s of 93 on separations, untangling and moves that did
+/// not mend the map.
+const FULL_BUDGET_FACES: f64 = 20_000.0;
+
+/// Least share of the full budgets.
+const MIN_BUDGET_SHARE: f64 = 0.1;
+
+/// Stalled `eps` updates the polish's untangler waits for, at least.
+const MIN_UNTANGLE_PATIENCE: usize = 3;
 
 /// ARAP iterations after the rounding, at most.
 const ARAP_ITERATIONS: usize = 20;
@@ -439,7 +461,8 @@ impl Quantizer {
         let stiff = self.stiff_faces(&x0);
         let mut best: Option<Rounded> = None;
         for (pass, &weight) in STIFF_WEIGHTS.iter().enumerate() {
-            if pass > 0 && (best.as_ref().is_some_and(|b| b.collapsed + b.wound == 0) || !stiff.contains(&true)) {
+            let settled = |b: &Rounded| b.collapsed + b.wound == 0 || b.collapsed + b.wound > STIFF_PASS_LIMIT;
+            if pass > 0 && (best.as_ref().is_some_and(settled) || !stiff.contains(&true)) {
                 break;
             }
             let fit = Fit::new(&self.elements, &stiff, weight);
@@ -745,11 +768,17 @@ impl Quantizer {
         let (mut moves, mut trials, mut sideways) = (0, 0, 0);
         let mut seen = std::collections::HashSet::new();
         seen.insert(values.to_vec());
-        while !violated.is_empty() && trials < SEPARATION_TRIALS {
+        let max_trials = self.budget(SEPARATION_TRIALS);
+        while !violated.is_empty() && trials < max_trials {
             let mut best: Option<SeparationMove> = None;
             let mut improved = false;
             'pairs: for sep in violated.clone() {
-                // The gap x_hi - x_lo is linear: one adjoint solve for it.
+                // The gap x_hi - x_lo is linear: one adjoint solve for it
+                // (counted with the trials: each is a solve).
+                if trials >= max_trials {
+                    break 'pairs;
+                }
+                trials += 1;
                 let gap_gain = system.sensitivity(&[(sep.hi, 1), (sep.lo, -1)])?;
                 let mut candidates: Vec<(f64, usize, usize, i64)> = system
                     .form_rows
@@ -766,7 +795,7 @@ impl Quantizer {
                     .collect();
                 candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
                 for &(_, form, row, step) in candidates.iter().take(CANDIDATES_PER_SEPARATION) {
-                    if trials >= SEPARATION_TRIALS {
+                    if trials >= max_trials {
                         break 'pairs;
                     }
                     let mut trial = values.to_vec();
@@ -810,6 +839,25 @@ impl Quantizer {
         Ok(moves)
     }
 
+    /// `full` scaled by the share of the full budgets this mesh gets
+    /// ([`FULL_BUDGET_FACES`]), at least 1.
+    fn budget(&self, full: usize) -> usize {
+        let share = (FULL_BUDGET_FACES / self.elements.len().max(1) as f64).clamp(MIN_BUDGET_SHARE, 1.0);
+        ((full as f64 * share).round() as usize).max(1)
+    }
+
+    /// The untangler's options in [`Self::polish`]: the default, its total
+    /// iterations and patience scaled by [`Self::budget`] (patience at
+    /// least [`MIN_UNTANGLE_PATIENCE`]).
+    fn polish_untangle(&self) -> UntangleOptions {
+        let default = UntangleOptions::default();
+        UntangleOptions {
+            max_total: self.budget(default.max_total),
+            patience: self.budget(default.patience).max(MIN_UNTANGLE_PATIENCE),
+            ..default
+        }
+    }
+
     /// Untangles `x` under `system`'s rows when it folds, then runs ARAP
     /// local/global iterations (eq. 4), each step kept unless it makes the
     /// map worse by [`Self::badness`]. Returns the map, its badness, the ARAP
@@ -834,7 +882,7 @@ impl Quantizer {
                 &self.elements,
                 &precondition,
                 &mut xm,
-                &UntangleOptions::default(),
+                &self.polish_untangle(),
             );
             let candidate = system.onto_constraints(xm.iter().map(|v| v / s).collect())?;
             let f = self.badness(&candidate, s);
@@ -895,7 +943,8 @@ impl Quantizer {
         let violated = self.violated_separations(x).len();
         let (mut trials, mut kept) = (0, 0);
         let mut tried = std::collections::HashSet::new();
-        while badness > 0 && trials < UNCOLLAPSE_TRIALS {
+        let (max_trials, max_probes) = (self.budget(UNCOLLAPSE_TRIALS), self.budget(UNCOLLAPSE_PROBES));
+        while badness > 0 && trials < max_trials {
             let mut unknowns: Vec<usize> = self
                 .flipped_faces(x, s)
                 .iter()
@@ -903,7 +952,7 @@ impl Quantizer {
                 .collect();
             unknowns.sort_unstable();
             unknowns.dedup();
-            unknowns.truncate(UNCOLLAPSE_PROBES);
+            unknowns.truncate(max_probes);
             let mut gain = vec![0.0f64; system.b.len()];
             for &u in &unknowns {
                 for (g, d) in gain.iter_mut().zip(system.sensitivity(&[(u, 1)])?) {
@@ -924,7 +973,7 @@ impl Quantizer {
             let mut improved = false;
             for (_, form, row, step) in candidates {
                 let v = values[form].unwrap_or(0) + step;
-                if trials >= UNCOLLAPSE_TRIALS || !tried.insert((form, v)) {
+                if trials >= max_trials || !tried.insert((form, v)) {
                     continue;
                 }
                 trials += 1;

@@ -29,9 +29,6 @@ use super::element::Element;
 /// cow at `--sharp 60`: 39 inverted triangles became 5 600). 1/2 keeps the scale.
 const AREA_WEIGHT: f64 = 0.5;
 
-/// `eps` updates without fewer inverted triangles before giving up.
-const PATIENCE: usize = 10;
-
 /// Past steps kept by L-BFGS.
 const HISTORY: usize = 8;
 
@@ -44,11 +41,13 @@ pub struct UntangleOptions {
     pub max_inner: usize,
     /// Cap on L-BFGS iterations in all.
     pub max_total: usize,
+    /// `eps` updates without fewer inverted triangles before giving up.
+    pub patience: usize,
 }
 
 impl Default for UntangleOptions {
     fn default() -> Self {
-        UntangleOptions { max_outer: 60, max_inner: 200, max_total: 3000 }
+        UntangleOptions { max_outer: 60, max_inner: 200, max_total: 3000, patience: 10 }
     }
 }
 
@@ -246,7 +245,7 @@ pub(super) fn untangle(elements: &[Element], precondition: &dyn Fn(&mut [f64]), 
             (fewest, stalled) = (inverted, 0);
         } else {
             stalled += 1;
-            if stalled >= PATIENCE {
+            if stalled >= options.patience {
                 break;
             }
         }
