@@ -402,14 +402,13 @@ impl Quantizer {
             }
         }
         let uv = |w: usize| [x0[self.vars[0][w]], x0[self.vars[1][w]]];
-        let radius = STIFF_RADIUS;
         let mut stiff = vec![false; self.elements.len()];
         let mut seen = vec![usize::MAX; n_wedges];
         for c in (0..n_wedges).filter(|&w| (0..2).all(|k| self.form_of[self.vars[k][w]] != usize::MAX)) {
             let p = uv(c);
             let near = |w: usize| {
                 let q = uv(w);
-                (q[0] - p[0]).hypot(q[1] - p[1]) < radius
+                (q[0] - p[0]).hypot(q[1] - p[1]) < STIFF_RADIUS
             };
             let mut stack = vec![c];
             seen[c] = c;
@@ -473,7 +472,7 @@ impl Quantizer {
             let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
             let better = best.as_ref().is_none_or(|b| key(&rounded) < key(b));
             if better {
-                best = Some(Rounded { stiff_weight: weight, ..rounded });
+                best = Some(rounded);
             }
         }
         let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, .. } =
@@ -550,10 +549,9 @@ impl Quantizer {
         s: f64,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<Rounded, QuantizeError> {
-        let x0 = x0.to_vec();
         let mut values: Vec<Option<i64>> = vec![None; self.forms.len()];
         let mut order: Vec<usize> = Vec::new();
-        let mut x = x0.clone();
+        let mut x = x0.to_vec();
         let mut batches = 0;
         let mut separation_moves = 0;
         let mut system = None;
@@ -604,7 +602,7 @@ impl Quantizer {
                     batch.splice(0..0, conflicting);
                 };
                 let mut solved = solved;
-                separation_moves += self.separate(&mut solved, &mut values, &x0, targets)?;
+                separation_moves += self.separate(&mut solved, &mut values, x0, targets)?;
                 x = solved.x.clone();
                 // A candidate the batch's other forms already determine takes the
                 // value the solve gives it.
@@ -635,7 +633,7 @@ impl Quantizer {
                     &mut moved_values,
                     &mut moved_x,
                     &mut moved_system,
-                    &x0,
+                    x0,
                     targets,
                     s,
                 )?;

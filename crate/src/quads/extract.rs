@@ -180,12 +180,6 @@ fn close_polygons(mesh: &TriMesh, polygons: &[faces::Polygon], quads: &mut QuadM
     if polygons.is_empty() {
         return;
     }
-    let mut faces_of: Vec<Vec<u32>> = vec![Vec::new(); mesh.n_vertices()];
-    for (f, face) in mesh.faces().iter().enumerate() {
-        for &v in face {
-            faces_of[v as usize].push(f as u32);
-        }
-    }
     for polygon in polygons {
         let n = polygon.corners.len();
         let centroid = polygon
@@ -200,7 +194,7 @@ fn close_polygons(mesh: &TriMesh, polygons: &[faces::Polygon], quads: &mut QuadM
             .collect();
         for _ in 0..2 {
             let grown: Vec<u32> =
-                near.iter().flat_map(|&v| faces_of[v as usize].iter().flat_map(|&f| mesh.faces()[f as usize])).collect();
+                near.iter().flat_map(|&v| mesh.vertex_faces(v).flat_map(|f| mesh.faces()[f as usize])).collect();
             near.extend(grown);
             near.sort_unstable();
             near.dedup();
