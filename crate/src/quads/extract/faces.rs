@@ -37,8 +37,13 @@ impl Cells {
         let p = qv.slot_origin(mesh, map, cycle[0]);
         let (a, b) = (axis(dir), axis((dir + 1) % 4));
         let corners: [Point; 4] = [p, add(p, a), add(add(p, a), b), add(p, b)];
-        self.uv.extend(corners.iter().map(|c| [c[0] as f64 / ONE as f64, c[1] as f64 / ONE as f64]));
+        self.uv.extend(corners.iter().map(|&c| grid_uv(c)));
     }
+}
+
+/// A fixed-point point in grid units.
+fn grid_uv(p: Point) -> [f64; 2] {
+    p.map(|x| x as f64 / ONE as f64)
 }
 
 /// Whether the half-edges of `cycle` leave distinct quad vertices.
@@ -155,7 +160,7 @@ pub(super) fn build_quads(
                 }
                 n if n % 2 == 0 => {
                     let corners = piece.iter().map(|&c| qv.slot_owner[c as usize]).collect();
-                    let uv = piece.iter().map(|&c| qv.slot_origin(mesh, map, c).map(|x| x as f64 / ONE as f64)).collect();
+                    let uv = piece.iter().map(|&c| grid_uv(qv.slot_origin(mesh, map, c))).collect();
                     cells.polygons.push(Polygon { corners, uv });
                     done.push(format!("closed {n} sides with {} quads around a vertex inside", n / 2));
                 }
