@@ -98,3 +98,25 @@ fn alpha_sweep_trades_cones_for_distortion() {
         assert!(runs[3].2 > runs[0].2, "{name}: phi_rms larger at 100 than at 0.001: {runs:?}");
     }
 }
+
+/// `max_cone_index` bounds interior cones (default 1: quad valence 4 - k of
+/// at least 3). The cow's horn tips carry cones of index 3 when the bound
+/// is 3 (valence 1: no quad mesh has them, the tip is cut off); under the
+/// default every interior cone has |k| = 1 on the positive side, the
+/// quarter turns spread nearby, and Gauss-Bonnet still holds.
+#[test]
+fn max_cone_index_bounds_interior_cones() {
+    let mesh = shared_mesh("cow.obj");
+    let none = FeatureSet::none(&mesh);
+    let place = |max_cone_index| {
+        let options = ConeOptions { max_cone_index, ..ConeOptions::default() };
+        place_cones(&mesh, &none, &options, &mut |_| {}).unwrap()
+    };
+    let loose = place(3);
+    assert!(loose.cones.iter().any(|c| c.k == 3), "the horn tips' cones of index 3 are gone: {:?}", loose.cones);
+    check_exact("cow, index <= 3", &mesh, &loose);
+    let bounded = place(1);
+    check_exact("cow, index <= 1", &mesh, &bounded);
+    assert!(bounded.cones.iter().all(|c| c.k <= 1), "{:?}", bounded.cones);
+    assert!(bounded.cones.len() > loose.cones.len());
+}

@@ -46,7 +46,7 @@ commands:
 
   cones FILE [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
-             [--boundary aligned|free] [--no-moves] [--json]
+             [--boundary aligned|free] [--max-cone-index K] [--no-moves] [--json]
                        place cones (Myles & Zorin 2013, sections 4-5).
                        --alpha: alpha_smooth, 1e-4..1e3 (default 0.01; 100
                        with --miq). --miq: MIQ emulation (no harmonic
@@ -62,8 +62,13 @@ commands:
                        by end positions. --boundary free: leave the mesh's
                        boundary off the isolines (no corners; for scans with
                        holes and texture atlases; features stay aligned);
-                       default aligned. --no-moves: skip the cone-location
-                       optimization. --json prints one JSON object.
+                       default aligned. --max-cone-index K: largest index of
+                       an interior cone, 1..3 (default 1: every cone has
+                       quad valence 4 - k >= 3; 2 or 3 allow the fewer,
+                       sharper cones a UV map may prefer, e.g. one of
+                       index 3 on a horn tip). --no-moves: skip the
+                       cone-location optimization. --json prints one JSON
+                       object.
                        On a terminal, the stage and its progress (rounding
                        round and integers left, cone-move pass, ARAP and
                        injective iterations) show on standard error while
@@ -71,7 +76,7 @@ commands:
 
   solve FILE -o OUT [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
-             [--boundary aligned|free] [--no-moves] [--report REPORT.json] [--checker]
+             [--boundary aligned|free] [--max-cone-index K] [--no-moves] [--report REPORT.json] [--checker]
                        place cones, compute the seamless parametrization and
                        write the mesh with UVs to OUT: .glb, .gltf (buffer
                        embedded) or .obj, by extension. Vertices are split
@@ -111,7 +116,7 @@ const COMMANDS: &[(&str, &[&str])] = &[
     ("info", &["--json"]),
     (
         "cones",
-        &["--json", "--quiet", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features=", "--boundary="],
+        &["--json", "--quiet", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features=", "--boundary=", "--max-cone-index="],
     ),
     (
         "solve",
@@ -126,6 +131,7 @@ const COMMANDS: &[(&str, &[&str])] = &[
             "--min-feature-length=",
             "--features=",
             "--boundary=",
+            "--max-cone-index=",
             "--report=",
             "--grid=",
             "--quads=",
@@ -144,6 +150,8 @@ const COMMANDS: &[(&str, &[&str])] = &[
             "--sharp=",
             "--min-feature-length=",
             "--features=",
+            "--boundary=",
+            "--max-cone-index=",
             "--report=",
             "--quad-size=",
             "--quads=",
@@ -397,7 +405,19 @@ fn cone_options(args: &Args) -> Result<ConeOptions, Failure> {
         Some("free") => BoundaryMode::Free,
         Some(other) => return Err(usage(&format!("--boundary expects aligned or free, got \"{other}\""))),
     };
-    Ok(ConeOptions { alpha_smooth: alpha, miq, optimize_locations: !args.flag("--no-moves"), boundary, ..ConeOptions::default() })
+    let max_cone_index = match args.number("--max-cone-index")? {
+        None => ConeOptions::default().max_cone_index,
+        Some(k) if [1.0, 2.0, 3.0].contains(&k) => k as i64,
+        Some(k) => return Err(usage(&format!("--max-cone-index expects 1, 2 or 3, got {k}"))),
+    };
+    Ok(ConeOptions {
+        alpha_smooth: alpha,
+        miq,
+        optimize_locations: !args.flag("--no-moves"),
+        boundary,
+        max_cone_index,
+        ..ConeOptions::default()
+    })
 }
 
 /// The stage and its progress on one line of standard error, while a long

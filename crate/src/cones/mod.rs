@@ -61,6 +61,12 @@ pub struct ConeOptions {
     pub rounding: RoundingRule,
     /// Whether the mesh's own boundary is held on isolines.
     pub boundary: BoundaryMode,
+    /// Largest index of an interior cone (1..=3; above 3 a cone has no
+    /// angle). 1, the default, keeps every cone's quad valence `4 - k` at 3
+    /// or more: a cone of index 2 or 3 becomes a valence-2 or valence-1
+    /// vertex, whose quads fold (cow's horn tips at 3 000 quads); the
+    /// excess quarter turns are spread onto nearby vertices.
+    pub max_cone_index: i64,
 }
 
 /// What the boundary of the input mesh must do (features are always aligned).
@@ -102,6 +108,7 @@ impl Default for ConeOptions {
             coarse_vertices: COARSE_VERTICES,
             rounding: RoundingRule::PerCluster,
             boundary: BoundaryMode::Aligned,
+            max_cone_index: 1,
         }
     }
 }

@@ -65,7 +65,7 @@ fn improve(
     progress: &mut dyn FnMut(ConeProgress),
 ) -> Result<(usize, usize, usize, usize), ConeError> {
     let moves = if options.optimize_locations {
-        sys.optimize_locations(options.max_move_passes, &mut |pass, tried, cones| {
+        sys.optimize_locations(options.max_move_passes, options.max_cone_index, &mut |pass, tried, cones| {
             progress(ConeProgress::ConeMoves { component: c, pass, tried, cones })
         })?
     } else {
@@ -79,9 +79,17 @@ fn improve(
     } else {
         0
     };
-    // Last, so that no later step gathers the quarter turns again.
-    let spread = sys.spread_degenerate_cones()?;
-    Ok((moves, merged, cancelled, spread))
+    // After the clean-ups, so that none of them gathers the quarter turns
+    // again; the moves that follow keep every cone within the bound.
+    let spread = sys.spread_degenerate_cones(options.max_cone_index)?;
+    let settled = if spread > 0 && options.optimize_locations {
+        sys.optimize_locations(options.max_move_passes, options.max_cone_index, &mut |pass, tried, cones| {
+            progress(ConeProgress::ConeMoves { component: c, pass, tried, cones })
+        })?
+    } else {
+        0
+    };
+    Ok((moves + settled, merged, cancelled, spread))
 }
 
 /// Component placements that do not fit the problem: a component missing or
@@ -308,7 +316,7 @@ impl ConeProblem {
                     let given: Vec<i64> = lsys.tree.vertices.iter().map(|&v| k[to_sub[v as usize] as usize]).collect();
                     lsys.fix_indices(&given).ok()?;
                     if options.optimize_locations {
-                        lsys.optimize_locations(options.max_move_passes, &mut |_, _, _| {}).ok()?;
+                        lsys.optimize_locations(options.max_move_passes, options.max_cone_index, &mut |_, _, _| {}).ok()?;
                     }
                 }
             }

@@ -28,3 +28,31 @@ pub fn grid(nx: usize, ny: usize, embed: impl Fn(f64, f64) -> [f64; 3]) -> RawMe
     }
     RawMesh { positions, triangles }
 }
+
+/// A closed cylinder of radius 1 and height `height` around the z axis as a
+/// CAD exporter writes it: `n_around` rim vertices at each end, the side
+/// one band of long triangles, each flat cap a fan from its first rim
+/// vertex (ear clipping of a convex polygon). The rims are the only sharp
+/// edges (90°).
+pub fn cad_cylinder(n_around: usize, height: f64) -> RawMesh {
+    use std::f64::consts::PI;
+    let n = n_around as u32;
+    let positions = [0.0, height]
+        .iter()
+        .flat_map(|&z| {
+            (0..n_around).map(move |i| {
+                let a = 2.0 * PI * i as f64 / n_around as f64;
+                [a.cos(), a.sin(), z]
+            })
+        })
+        .collect();
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        let (a, b, c, d) = (i, (i + 1) % n, n + (i + 1) % n, n + i);
+        triangles.extend([[a, b, c], [a, c, d]]);
+    }
+    for i in 1..n - 1 {
+        triangles.extend([[0, i + 1, i], [n, n + i, n + i + 1]]);
+    }
+    RawMesh { positions, triangles }
+}

@@ -212,10 +212,10 @@ enum FormKind {
 struct Form {
     row: Vec<(usize, i64)>,
     kind: FormKind,
-    /// Disk component of the cut (index into the pins).
-    component: usize,
-    /// Change of the form under a translation `d` of the whole component: `response · d`.
-    response: [i64; 2],
+    /// Change of the form under translations `d_c` of the disk components
+    /// (indices into the pins): `sum (2 c + k, a) a d_c[k]`. A seam
+    /// translation between two components responds to both.
+    response: Vec<(usize, i64)>,
 }
 
 impl Form {
@@ -1065,26 +1065,22 @@ impl Quantizer {
     ) -> Result<(RoundedSystem, Vec<usize>), QuantizeError> {
         let mut rows = self.seam_rows.clone();
         let mut rhs_rows = vec![0.0; rows.len()];
-        let mut constrained = vec![Vec::<[i64; 2]>::new(); self.pins.len()];
+        let mut responses = Vec::with_capacity(order.len() + 2 * self.pins.len());
         for &i in order {
             let form = &self.forms[i];
             rows.push(form.row.clone());
             rhs_rows.push(values[i].unwrap_or(0) as f64);
-            constrained[form.component].push(form.response);
+            responses.push(form.response.clone());
         }
-        // A component's translations the rounded forms do not fix are held by its pin.
-        for (c, pin) in self.pins.iter().enumerate() {
-            for (k, &unknown) in pin.iter().enumerate() {
-                let mut unit = [0i64; 2];
-                unit[k] = 1;
-                let mut with = constrained[c].clone();
-                with.push(unit);
-                if translation_rank(&with) > translation_rank(&constrained[c]) {
-                    constrained[c].push(unit);
-                    rows.push(vec![(unknown, 1)]);
-                    rhs_rows.push(x[unknown]);
-                }
-            }
+        // The component translations the rounded forms do not fix are held
+        // by pins: a pin is kept when its translation is independent of the
+        // forms' responses and of the pins before it.
+        responses.extend((0..2 * self.pins.len()).map(|t| vec![(t, 1)]));
+        let free_translation = independent_rows(&responses, 2 * self.pins.len());
+        for (t, _) in free_translation[order.len()..].iter().enumerate().filter(|(_, &free)| free) {
+            let unknown = self.pins[t / 2][t % 2];
+            rows.push(vec![(unknown, 1)]);
+            rhs_rows.push(x[unknown]);
         }
         let keep = independent_rows(&rows, self.n_unknowns);
         let n_seam = self.seam_rows.len();
@@ -1344,18 +1340,6 @@ fn distance_to_integer(y: f64) -> f64 {
     (y - y.round()).abs()
 }
 
-/// Rank (0, 1 or 2) of a set of integer 2-vectors.
-fn translation_rank(v: &[[i64; 2]]) -> usize {
-    let Some(first) = v.iter().find(|a| a[0] != 0 || a[1] != 0) else {
-        return 0;
-    };
-    if v.iter().any(|a| first[0] * a[1] - first[1] * a[0] != 0) {
-        2
-    } else {
-        1
-    }
-}
-
 /// Disk component (index of its pin in `cut.pins`) of every wedge.
 fn wedge_components(cut: &CutGraph) -> Vec<usize> {
     let mut uf = UnionFind::new(cut.n_wedges);
@@ -1394,18 +1378,9 @@ fn integer_forms(
     let cm = &placement.cut.mesh;
     let mut set = RowSet::default();
     let mut forms = Vec::new();
-    let mut push = |mut row: Vec<(usize, i64)>,
-                    kind: FormKind,
-                    component: usize,
-                    response: [i64; 2],
-                    forms: &mut Vec<Form>| {
+    let mut push = |mut row: Vec<(usize, i64)>, kind: FormKind, response: Vec<(usize, i64)>, forms: &mut Vec<Form>| {
         if set.push(&mut row) {
-            forms.push(Form {
-                row: set.rows[set.rows.len() - 1].clone(),
-                kind,
-                component,
-                response,
-            });
+            forms.push(Form { row: set.rows[set.rows.len() - 1].clone(), kind, response });
         }
     };
     let mut represented = vec![false; cm.n_vertices()];
@@ -1420,8 +1395,8 @@ fn integer_forms(
                 } else {
                     FormKind::Cone
                 };
-                for (c, unit) in [(0, [1, 0]), (1, [0, 1])] {
-                    push(vec![(vars[c][w], 1)], kind, component[w], unit, &mut forms);
+                for c in 0..2 {
+                    push(vec![(vars[c][w], 1)], kind, vec![(2 * component[w] + c, 1)], &mut forms);
                 }
             }
         }
@@ -1430,15 +1405,7 @@ fn integer_forms(
         let c = isoline[h] as usize;
         if c < 2 {
             let w = cut.wedge[h] as usize;
-            let mut unit = [0, 0];
-            unit[c] = 1;
-            push(
-                vec![(vars[c][w], 1)],
-                FormKind::Point,
-                component[w],
-                unit,
-                &mut forms,
-            );
+            push(vec![(vars[c][w], 1)], FormKind::Point, vec![(2 * component[w] + c, 1)], &mut forms);
         }
     }
     for curve in &cut.curves {
@@ -1452,14 +1419,18 @@ fn integer_forms(
                     .filter(|&d| r[c][d] != 0)
                     .map(|d| (vars[d][fa as usize], -r[c][d])),
             );
-            let response = [i64::from(c == 0) - r[c][0], i64::from(c == 1) - r[c][1]];
-            push(
-                row,
-                FormKind::Translation,
-                component[fa as usize],
-                response,
-                &mut forms,
-            );
+            // Translations d_g, d_f of the two sides' components move it by
+            // (d_g - r d_f)_c (the sides may lie in different components).
+            let (cg, cf) = (component[ga as usize], component[fa as usize]);
+            let mut response = vec![(2 * cg + c, 1)];
+            for d in (0..2).filter(|&d| r[c][d] != 0) {
+                match response.iter_mut().find(|(t, _)| *t == 2 * cf + d) {
+                    Some(entry) => entry.1 -= r[c][d],
+                    None => response.push((2 * cf + d, -r[c][d])),
+                }
+            }
+            response.retain(|&(_, a)| a != 0);
+            push(row, FormKind::Translation, response, &mut forms);
         }
     }
     forms

@@ -31,7 +31,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let solve = clock.lap();
     let map = quantize(file, &solution, grid)?;
     let quantize_seconds = clock.lap();
-    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions { snap_tolerance: 1e-9, ..ExtractOptions::default() }).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let extract = clock.lap();
     let sharp: Vec<u32> = solution.features.edges().collect();
     let report = check_quads(&solution.mesh, &quads, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });

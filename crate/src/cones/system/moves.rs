@@ -228,10 +228,11 @@ impl ComponentSystem<'_> {
     /// until no move helps or `max_passes` passes. Candidates are ranked by
     /// the first-order change ([`Self::move_potential`]) and the two most
     /// promising per cone are evaluated exactly; after the first pass only
-    /// cones within two rings of a moved cone are reconsidered. Returns the
+    /// cones within two rings of a moved cone are reconsidered. No move
+    /// makes a cone's index exceed `max_index` or its own index. Returns the
     /// moves made; `progress(pass, tried, cones)` hears of each batch of
     /// candidate cones evaluated.
-    pub fn optimize_locations(&mut self, max_passes: usize, progress: &mut dyn FnMut(usize, usize, usize)) -> Result<usize, ConeError> {
+    pub fn optimize_locations(&mut self, max_passes: usize, max_index: i64, progress: &mut dyn FnMut(usize, usize, usize)) -> Result<usize, ConeError> {
         const EXACT_TRIES: usize = 2;
         let mut moves = 0;
         let mut current = self.phi_norm2();
@@ -254,7 +255,7 @@ impl ComponentSystem<'_> {
                     .one_ring(v)
                     .filter(|&w| !self.mesh.is_boundary_vertex(w))
                     .map(|w| self.local[w as usize] as usize)
-                    .filter(|&j| self.vertex_k_at(j) + ki <= MAX_CONE_INDEX)
+                    .filter(|&j| self.vertex_k_at(j) + ki <= max_index.max(ki))
                     .map(|j| (2.0 * ki as f64 * (potential[j] - potential[i]), j))
                     .filter(|&(estimate, _)| estimate < -MIN_DECREASE * current)
                     .collect();
@@ -280,7 +281,7 @@ impl ComponentSystem<'_> {
                     // An earlier move of this pass may have changed this cone
                     // or its candidates.
                     let k_now = self.vertex_k_at(i);
-                    if k_now == 0 || js.iter().any(|&j| self.vertex_k_at(j) + k_now > MAX_CONE_INDEX) {
+                    if k_now == 0 || js.iter().any(|&j| self.vertex_k_at(j) + k_now > max_index.max(k_now)) {
                         continue;
                     }
                     let own;
@@ -324,16 +325,18 @@ impl ComponentSystem<'_> {
         Ok(moves)
     }
 
-    /// Splits interior cones of index above [`MAX_CONE_INDEX`] (angle <= 0:
-    /// no seamless map has them), one quarter turn at a time, onto the
-    /// interior vertex within two rings that keeps its index within the
-    /// bound and gives the lowest `phiᵀ M phi / A`. A cone with no such
-    /// vertex is left (the pipeline then refines around it). Returns the
-    /// quarter turns moved.
-    pub fn spread_degenerate_cones(&mut self) -> Result<usize, ConeError> {
+    /// Splits interior cones of index above `max_index` (clamped to
+    /// [`MAX_CONE_INDEX`]: above it a cone has angle <= 0 and no seamless map
+    /// has it), one quarter turn at a time, onto the interior vertex within
+    /// two rings that keeps its index within the bound and gives the lowest
+    /// `phiᵀ M phi / A`. A cone with no such vertex is left (above 3 the
+    /// pipeline then refines around it). Returns the quarter turns moved.
+    pub fn spread_degenerate_cones(&mut self, max_index: i64) -> Result<usize, ConeError> {
+        let max_index = max_index.clamp(1, MAX_CONE_INDEX);
         let mut moved = 0;
         let dim = self.response_width();
-        while let Some((i, _)) = self.interior_cones().into_iter().find(|&(_, k)| k > MAX_CONE_INDEX) {
+        let mut stuck: Vec<usize> = Vec::new();
+        while let Some((i, _)) = self.interior_cones().into_iter().find(|&(i, k)| k > max_index && !stuck.contains(&i)) {
             let v = self.tree.vertices[i];
             let mut near: Vec<u32> = self.mesh.one_ring(v).flat_map(|a| self.mesh.one_ring(a).chain([a])).collect();
             near.sort_unstable();
@@ -342,7 +345,7 @@ impl ComponentSystem<'_> {
                 .into_iter()
                 .filter(|&w| w != v && !self.mesh.is_boundary_vertex(w))
                 .map(|w| self.local[w as usize] as usize)
-                .filter(|&j| self.vertex_k_at(j) < MAX_CONE_INDEX)
+                .filter(|&j| self.vertex_k_at(j) < max_index)
                 .collect();
             let mut best: Option<(f64, usize, Vec<f64>)> = None;
             for chunk in candidates.chunks(self.trial_columns()) {
@@ -356,7 +359,10 @@ impl ComponentSystem<'_> {
                     }
                 }
             }
-            let Some((_, j, d)) = best else { break };
+            let Some((_, j, d)) = best else {
+                stuck.push(i);
+                continue;
+            };
             self.accept(&[(i, j, 1)], &d);
             moved += 1;
         }
