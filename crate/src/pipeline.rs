@@ -44,6 +44,10 @@ impl Default for RefineOptions {
     }
 }
 
+/// Below this many faces a mesh whose map still folds after the local
+/// refinements is refined everywhere and solved again ([`Placed::parametrize`]).
+pub const LOW_POLY_FACES: usize = 5_000;
+
 /// Progress of either stage.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SolveProgress {
@@ -554,6 +558,23 @@ impl Placed {
                 retry.cones.rounding = RoundingRule::Whole;
             }
             let stage = ConeStage::with_refinement(mesh, features, &retry, initial, 0, refine_seconds, now_seconds());
+            let attempt = stage
+                .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
+                .and_then(|placed| placed.parametrize(mesh, features, progress));
+            if let Ok(solution) = attempt {
+                return Ok(solution);
+            }
+        }
+        // A low-poly mesh (a CAD export: long, thin triangles between
+        // features) may have too few vertices for any map without folds:
+        // split the longest edge of every face and solve again, until the
+        // mesh is no longer low-poly.
+        let m = &best.param.metrics;
+        if (m.flipped > 0 || m.wound_vertices > 0) && best.mesh.n_faces() < LOW_POLY_FACES {
+            let mut clock = Stopwatch::start();
+            let all: Vec<u32> = (0..best.mesh.n_faces() as u32).collect();
+            let refined = split_flipped(mesh, features, best.refinement_of_input(), &all);
+            let stage = ConeStage::with_refinement(mesh, features, &options, Some(refined), 0, best.refine_seconds + clock.lap(), now_seconds());
             let attempt = stage
                 .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
                 .and_then(|placed| placed.parametrize(mesh, features, progress));

@@ -233,3 +233,18 @@ mod random_features {
     }
 }
 
+
+/// A low-poly CAD export (a cylinder of 48 segments: its caps fans of long,
+/// thin triangles, 188 faces) has too few vertices for a map without folds
+/// even after the local refinements; the mesh is then refined everywhere
+/// and solved again, and the result says what was inserted.
+#[test]
+fn a_low_poly_cad_cylinder_solves_after_refining_everywhere() {
+    let raw = conemap::mesh::shapes::cad_cylinder(48, 2.0);
+    let mesh = TriMesh::from_raw(&raw).unwrap();
+    assert!(mesh.n_faces() < conemap::pipeline::LOW_POLY_FACES);
+    let features = FeatureSet::sharp_edges(&mesh, 60.0);
+    assert_eq!(features.len(), 96);
+    let solution = check("low-poly cylinder", &mesh, &features);
+    assert!(solution.mesh.n_faces() > 2 * mesh.n_faces(), "refined to {} faces", solution.mesh.n_faces());
+}

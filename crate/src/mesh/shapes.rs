@@ -30,12 +30,13 @@ pub fn grid(nx: usize, ny: usize, embed: impl Fn(f64, f64) -> [f64; 3]) -> RawMe
 }
 
 /// A closed cylinder of radius 1 and height `height` around the z axis as a
-/// CAD exporter writes it: `n_around` rim vertices at each end, the side
-/// one band of long triangles, each flat cap a fan from its first rim
-/// vertex (ear clipping of a convex polygon). The rims are the only sharp
-/// edges (90°).
+/// CAD kernel exports it: `n_around` rim vertices at each end (even, at
+/// least 4), the side one band of long triangles, each flat cap a zigzag
+/// strip of long, thin triangles across the disk (no interior vertex). The
+/// rims are the only sharp edges (90°).
 pub fn cad_cylinder(n_around: usize, height: f64) -> RawMesh {
     use std::f64::consts::PI;
+    assert!(n_around >= 4 && n_around.is_multiple_of(2), "cad_cylinder: an even number of segments, at least 4");
     let n = n_around as u32;
     let positions = [0.0, height]
         .iter()
@@ -51,8 +52,24 @@ pub fn cad_cylinder(n_around: usize, height: f64) -> RawMesh {
         let (a, b, c, d) = (i, (i + 1) % n, n + (i + 1) % n, n + i);
         triangles.extend([[a, b, c], [a, c, d]]);
     }
-    for i in 1..n - 1 {
-        triangles.extend([[0, i + 1, i], [n, n + i, n + i + 1]]);
+    // The strip grows from rim vertex n/2 to either side until it closes at 0.
+    let (mut left, mut right) = (n / 2 - 1, n / 2 + 1);
+    let mut strip = vec![[left, n / 2, right]];
+    while strip.len() < n_around - 2 {
+        if strip.len() % 2 == 1 {
+            strip.push([left - 1, left, right]);
+            left -= 1;
+        } else {
+            strip.push([left, right, (right + 1) % n]);
+            right = (right + 1) % n;
+        }
+    }
+    // On a convex polygon a triangle listed in increasing index order is
+    // counter-clockwise: seen from +z on the top cap, from -z reversed.
+    for mut t in strip {
+        t.sort_unstable();
+        triangles.push([t[2], t[1], t[0]]);
+        triangles.push(t.map(|v| v + n));
     }
     RawMesh { positions, triangles }
 }
