@@ -16,7 +16,9 @@
 //! the seamless map is at least as long along `c` as along the other
 //! coordinate (a cone at the end of an isoline, or two cones one above the
 //! other, may share the line); or when they are the corners of one triangle
-//! (which they would collapse, whatever the direction).
+//! (which they would collapse, whatever the direction); or when one is an
+//! isoline and the other lies between two of its vertices along it (a cone
+//! a fraction of a cell from a feature curve: the CAD cylinder's rim).
 
 use super::element::Element;
 use std::collections::HashSet;
@@ -66,6 +68,23 @@ pub(super) fn separations(elements: &[Element], integral: &[bool], seamless: &[f
                 found.insert(if d[c] > 0.0 { Separation { lo: a, hi: b } } else { Separation { lo: b, hi: a } });
             }
         }
+        // An isoline (one unknown at several corners of the star) is a line:
+        // a corner beside it, between its ends along the line, is side by
+        // side with it across the line however short the step to the line
+        // (a cone next to a feature curve, between two of its vertices).
+        for &(b, c, pb) in corners {
+            let along = corners.iter().filter(|e| e.0 == b).map(|e| e.2[1 - c]);
+            let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+            if !(hi > lo) {
+                continue;
+            }
+            for &(a, ca, pa) in corners {
+                if a == b || ca != c || !(lo..=hi).contains(&pa[1 - c]) || pa[c] == pb[c] {
+                    continue;
+                }
+                found.insert(if pb[c] > pa[c] { Separation { lo: a, hi: b } } else { Separation { lo: b, hi: a } });
+            }
+        }
     }
     // A triangle whose corners are two forms of one coordinate collapses
     // when they are equal, whatever the direction between them.
@@ -104,4 +123,31 @@ pub(super) fn by_form(list: &[Separation], form_of: &[usize], n_forms: usize) ->
         }
     }
     of
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cone one small step above a feature isoline `v = 0`, between two of
+    /// its vertices and sharing no triangle with both: every displacement
+    /// from the cone to an isoline vertex is longer along u than along v,
+    /// yet the cone must stay a grid line above the isoline.
+    #[test]
+    fn a_cone_beside_an_isoline_between_its_vertices_stays_off_it() {
+        // Wedges: 0, 1 on the isoline at u = 0 and 1; 2 an interior vertex;
+        // 3 the cone. Unknowns: u of wedge i is i; v of the isoline is 10,
+        // of wedge 2 is 12, of the cone 11.
+        let x = |w: [usize; 3]| [w, w.map(|i| [10, 10, 12, 11][i])];
+        let q = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let elements: Vec<Element> = [[0, 1, 2], [0, 2, 3], [2, 1, 3]].into_iter().map(|w| Element::new(q, 0.5, w, x(w))).collect();
+        let mut seamless = vec![0.0; 13];
+        seamless[..4].copy_from_slice(&[0.0, 1.0, 0.5, 0.5]);
+        (seamless[10], seamless[12], seamless[11]) = (0.0, 0.05, 0.1);
+        let mut integral = vec![false; 13];
+        for u in [3, 10, 11] {
+            integral[u] = true;
+        }
+        assert_eq!(separations(&elements, &integral, &seamless), vec![Separation { lo: 10, hi: 11 }]);
+    }
 }
