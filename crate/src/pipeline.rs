@@ -359,6 +359,22 @@ pub fn solve<'a>(
     placed.parametrize(mesh, features, progress)
 }
 
+/// [`solve`] on the refinement `refined` of `mesh` (`None`: the input
+/// itself) made in `refine_seconds`: cones placed anew, then
+/// [`Placed::parametrize`] with all its fallbacks.
+fn solve_refined<'a>(
+    mesh: &'a TriMesh,
+    features: &'a FeatureSet,
+    options: &SolveOptions,
+    refined: Option<Refined>,
+    refine_seconds: f64,
+    progress: &mut dyn FnMut(SolveProgress),
+) -> Result<Solution<'a>, SolveError> {
+    ConeStage::with_refinement(mesh, features, options, refined, 0, refine_seconds, now_seconds())
+        .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
+        .and_then(|placed| placed.parametrize(mesh, features, progress))
+}
+
 /// The cone stage of [`solve`] alone: the refinement the features need,
 /// every component placed (on this thread, or two natively), and the
 /// refinements around cones of angle 0.
@@ -557,11 +573,7 @@ impl Placed {
             } else {
                 retry.cones.rounding = RoundingRule::Whole;
             }
-            let stage = ConeStage::with_refinement(mesh, features, &retry, initial, 0, refine_seconds, now_seconds());
-            let attempt = stage
-                .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
-                .and_then(|placed| placed.parametrize(mesh, features, progress));
-            if let Ok(solution) = attempt {
+            if let Ok(solution) = solve_refined(mesh, features, &retry, initial, refine_seconds, progress) {
                 return Ok(solution);
             }
         }
@@ -574,11 +586,7 @@ impl Placed {
             let mut clock = Stopwatch::start();
             let all: Vec<u32> = (0..best.mesh.n_faces() as u32).collect();
             let refined = split_flipped(mesh, features, best.refinement_of_input(), &all);
-            let stage = ConeStage::with_refinement(mesh, features, &options, Some(refined), 0, best.refine_seconds + clock.lap(), now_seconds());
-            let attempt = stage
-                .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
-                .and_then(|placed| placed.parametrize(mesh, features, progress));
-            if let Ok(solution) = attempt {
+            if let Ok(solution) = solve_refined(mesh, features, &options, Some(refined), best.refine_seconds + clock.lap(), progress) {
                 return Ok(solution);
             }
         }

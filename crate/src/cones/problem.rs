@@ -64,13 +64,12 @@ fn improve(
     c: usize,
     progress: &mut dyn FnMut(ConeProgress),
 ) -> Result<(usize, usize, usize, usize), ConeError> {
-    let moves = if options.optimize_locations {
+    let move_cones = |sys: &mut ComponentSystem, progress: &mut dyn FnMut(ConeProgress)| {
         sys.optimize_locations(options.max_move_passes, options.max_cone_index, &mut |pass, tried, cones| {
             progress(ConeProgress::ConeMoves { component: c, pass, tried, cones })
-        })?
-    } else {
-        0
+        })
     };
+    let moves = if options.optimize_locations { move_cones(sys, progress)? } else { 0 };
     let merged = if options.merge_close_pairs { sys.merge_close_pairs()? } else { 0 };
     let cancelled = if options.cancel_pairs_nearest > 0 {
         sys.cancel_pairs(options.cancel_pairs_nearest, &mut |removed, tried, trials| {
@@ -82,13 +81,7 @@ fn improve(
     // After the clean-ups, so that none of them gathers the quarter turns
     // again; the moves that follow keep every cone within the bound.
     let spread = sys.spread_degenerate_cones(options.max_cone_index)?;
-    let settled = if spread > 0 && options.optimize_locations {
-        sys.optimize_locations(options.max_move_passes, options.max_cone_index, &mut |pass, tried, cones| {
-            progress(ConeProgress::ConeMoves { component: c, pass, tried, cones })
-        })?
-    } else {
-        0
-    };
+    let settled = if spread > 0 && options.optimize_locations { move_cones(sys, progress)? } else { 0 };
     Ok((moves + settled, merged, cancelled, spread))
 }
 
