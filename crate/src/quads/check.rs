@@ -14,7 +14,9 @@
 //! cost is about linear in the number of samples and primitives.
 
 use super::QuadMesh;
-use crate::vec3::{add, bounds, cross, dot, midpoint, norm, scale, sub, V3};
+use crate::vec3::{
+    add, barycentric_point, bounds, closest_point_barycentric, cross, dot, midpoint, norm, scale, segment_parameter, sub, V3,
+};
 use crate::TriMesh;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -707,52 +709,13 @@ fn box_distance(p: V3, lo: V3, hi: V3) -> f64 {
 
 /// Distance from `p` to the segment `[a, b]` (a point when `a == b`).
 fn point_segment_distance(p: V3, a: V3, b: V3) -> f64 {
-    let ab = sub(b, a);
-    let len2 = dot(ab, ab);
-    let t = if len2 > 0.0 { (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
-    norm(sub(p, add(a, scale(ab, t))))
+    let t = segment_parameter(p, a, b);
+    norm(sub(p, add(a, scale(sub(b, a), t))))
 }
 
-/// Distance from `p` to the triangle `t` (closest-point regions after
-/// Ericson, Real-Time Collision Detection §5.1.5); a zero-area triangle is
-/// measured as its three edges.
+/// Distance from `p` to the triangle `t` (see [`closest_point_barycentric`]).
 fn point_triangle_distance(p: V3, t: &[V3; 3]) -> f64 {
-    let [a, b, c] = *t;
-    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let n = cross(ab, ac);
-    if !(dot(n, n) > 0.0) {
-        let edge = |(u, w): (V3, V3)| point_segment_distance(p, u, w);
-        return edge((a, b)).min(edge((b, c))).min(edge((c, a)));
-    }
-    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return norm(ap);
-    }
-    let bp = sub(p, b);
-    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return norm(bp);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return norm(sub(p, add(a, scale(ab, d1 / (d1 - d3)))));
-    }
-    let cp = sub(p, c);
-    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return norm(cp);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return norm(sub(p, add(a, scale(ac, d2 / (d2 - d6)))));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return norm(sub(p, add(b, scale(sub(c, b), w))));
-    }
-    // Inside: distance to the plane.
-    dot(ap, n).abs() / dot(n, n).sqrt()
+    norm(sub(p, barycentric_point(t, closest_point_barycentric(p, t))))
 }
 
 #[cfg(test)]

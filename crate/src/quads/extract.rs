@@ -9,13 +9,16 @@
 //!    exactly to the next integer point;
 //! 4. `faces::build_quads`: the cycles of traced half-edges are the quads;
 //! 5. `close_polygons`: a cycle of more sides (the map winds twice around a
-//!    point in the cell) is closed with quads around an input vertex there.
+//!    point in the cell) is closed with quads around an input vertex there;
+//! 6. `fill::fill_holes`: the holes left where cells were skipped (flipped
+//!    triangles) are filled with quads on the input surface.
 //!
 //! Every predicate after step 1 is exact integer arithmetic. Where the map is
 //! not a valid integer-grid map the extractor closes or skips what it cannot
 //! trace as a quad and records a [`QuadDefect`].
 
 mod faces;
+mod fill;
 mod snap;
 mod trace;
 mod vertices;
@@ -92,8 +95,10 @@ impl std::error::Error for ExtractError {}
 /// vertices, out-and-back isolines are dropped and the rest closed with
 /// quads around an input vertex ([`close_polygons`]), so the mesh has no
 /// hole there. Where the map is otherwise invalid (flips, non-integer
-/// transitions or cones) the affected cells are skipped. Both are listed in
-/// [`QuadMesh::defects`]. Errs only on a wrong number of UVs or a UV that is
+/// transitions or cones) the affected cells are skipped and the hole they
+/// leave is filled with quads whose new vertices lie on the input surface
+/// (even holes away from the input's boundary; others stay open). All of
+/// these are listed in [`QuadMesh::defects`]. Errs only on a wrong number of UVs or a UV that is
 /// not finite or beyond [`MAX_UV`]; never panics.
 pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) -> Result<QuadMesh, ExtractError> {
     let expected = 3 * mesh.n_faces();
@@ -139,12 +144,14 @@ pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) 
     }
     let mut quads = QuadMesh { positions, locations, quads: cells.quads, uv: cells.uv, defects };
     close_polygons(mesh, &cells.polygons, &mut quads);
+    fill::fill_holes(mesh, &mut quads);
     drop_unreferenced(&mut quads);
     Ok(quads)
 }
 
 /// Removes the vertices no quad uses (the tip of an isoline traced out and
-/// back inside a cell the map winds around), renumbering the rest in order.
+/// back inside a cell the map winds around, a hole filling's candidate
+/// vertices not chosen), renumbering the rest in order.
 fn drop_unreferenced(quads: &mut QuadMesh) {
     let mut new_index = vec![u32::MAX; quads.positions.len()];
     for q in &quads.quads {

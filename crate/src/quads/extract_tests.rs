@@ -3,7 +3,7 @@
 //! components, and invalid maps.
 
 use super::{extract_quads, ExtractError, ExtractOptions};
-use crate::quads::QuadMesh;
+use crate::quads::{QuadDefect, QuadMesh};
 use crate::TriMesh;
 use std::collections::HashMap;
 
@@ -596,7 +596,41 @@ fn flipped_triangles_are_defects_not_panics() {
     assert!(q.defects.iter().any(|d| d.what.contains("flipped")), "{:?}", q.defects);
     let t = topology(&q);
     assert!(t.manifold, "{t:?}");
-    assert!(q.n_quads() < 16);
+}
+
+/// A square map whose middle folds: the cells over the flipped triangles are
+/// skipped, and the hole they leave is filled with quads on the surface, so
+/// the quad mesh is still one watertight disk.
+#[test]
+fn holes_over_flipped_triangles_are_filled() {
+    let n = 8;
+    let (pos, tris, mut uv) = square(n, 2 * n, 0.0, 3);
+    let m = mesh(pos.clone(), tris.clone());
+    // Push the vertex at (4, 4) across its neighbours.
+    let centre = pos.iter().position(|p| p[0] == 4.0 && p[1] == 4.0).expect("grid vertex");
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            if t[k] as usize == centre {
+                uv[3 * f + k] = [5.3, 4.6];
+            }
+        }
+    }
+    let q = extract(&m, &uv);
+    assert!(q.defects.iter().any(|d| d.what.contains("flipped")), "{:?}", q.defects);
+    let filled: Vec<&QuadDefect> = q.defects.iter().filter(|d| d.what.contains("closed with")).collect();
+    assert!(!filled.is_empty(), "{:?}", q.defects);
+    assert!(!q.defects.iter().any(|d| d.what.contains("left open")), "{:?}", q.defects);
+    let t = topology(&q);
+    assert!(t.manifold, "{t:?}");
+    assert_eq!((t.euler, t.boundary_loops, t.unused_vertices), (1, 1, 0), "{t:?}");
+    assert_on_surface(&m, &q);
+    assert_unit_squares(&q);
+    // Filled quads are not folded: each has a positive area in the plane.
+    for quad in &q.quads {
+        let p = quad.map(|v| q.positions[v as usize]);
+        let area: f64 = (0..4).map(|i| p[i][0] * p[(i + 1) % 4][1] - p[(i + 1) % 4][0] * p[i][1]).sum();
+        assert!(area > 0.0, "{quad:?} {p:?}");
+    }
 }
 
 #[test]
