@@ -331,6 +331,12 @@ fn square_with_vertices_on_integer_points() {
 }
 
 #[test]
+fn a_long_input_boundary_is_not_a_hole() {
+    // 84 boundary quad edges: longer than any hole the extractor fills.
+    check_square(21, 14, 0.2, 4);
+}
+
+#[test]
 fn square_with_half_integer_vertices() {
     // Vertices on isolines between integer points; diagonals through them.
     check_square(3, 6, 0.0, 1);

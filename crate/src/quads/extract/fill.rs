@@ -37,14 +37,15 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
     for hole in holes(quads) {
         let first = quads.locations[hole[0] as usize].face;
         let n = hole.len();
-        let reason = if n % 2 == 1 {
+        let on_boundary = hole.iter().filter(|&&v| on_input_boundary(mesh, quads.locations[v as usize])).count();
+        let reason = if on_boundary == n {
+            continue; // the input's own boundary
+        } else if on_boundary > 0 {
+            Some("it touches the input's boundary")
+        } else if n % 2 == 1 {
             Some("it has an odd number of sides")
         } else if n > MAX_HOLE {
             Some("it is too long")
-        } else if hole.iter().all(|&v| on_input_boundary(mesh, quads.locations[v as usize])) {
-            continue; // the input's own boundary
-        } else if hole.iter().any(|&v| on_input_boundary(mesh, quads.locations[v as usize])) {
-            Some("it touches the input's boundary")
         } else {
             None
         };
