@@ -4,8 +4,9 @@
 //! here the traced mesh is closed afterwards instead. Every boundary loop of
 //! the quads that does not run along the input's boundary is such a hole;
 //! one with an even number of sides is filled with quads whose new vertices
-//! lie on the input surface, and recorded as a defect. Odd, pinched and
-//! boundary-touching holes stay open (also recorded).
+//! lie on the input surface, and recorded as a defect. Odd, overlong and
+//! boundary-touching holes stay open (also recorded); a loop through a
+//! vertex twice is left as it is.
 
 use crate::mesh::NONE;
 use crate::quads::{QuadDefect, QuadMesh, SurfacePoint};
