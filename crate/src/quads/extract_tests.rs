@@ -775,3 +775,27 @@ fn timing_large_cube() {
         t0.elapsed()
     );
 }
+
+/// Quads that overlap (here a traced quad repeated, as two closings of
+/// wound cells can overlap) are removed and the hole they leave filled:
+/// the mesh is a manifold disk again, and the repair is reported.
+#[test]
+fn overlapping_quads_are_removed_and_the_hole_filled() {
+    let (pos, tris, uv) = square(4, 8, 0.0, 6);
+    let m = mesh(pos, tris);
+    let mut q = extract(&m, &uv);
+    assert!(q.defects.is_empty(), "{:?}", q.defects);
+    let inside = |v: u32| q.positions[v as usize].iter().take(2).all(|&x| x > 0.0 && x < 4.0);
+    let k = q.quads.iter().position(|quad| quad.iter().all(|&v| inside(v))).expect("an interior quad");
+    let copy = q.quads[k];
+    q.quads.push(copy);
+    q.uv.extend_from_within(4 * k..4 * k + 4);
+    assert!(!topology(&q).manifold);
+    super::fill::fill_holes(&m, &mut q);
+    let t = topology(&q);
+    assert!(t.manifold, "{t:?}");
+    assert_eq!((t.euler, t.boundary_loops, q.n_quads()), (1, 1, 16), "{t:?}");
+    assert!(q.defects.iter().any(|d| d.what.contains("not a manifold")), "{:?}", q.defects);
+    assert!(q.defects.iter().any(|d| d.what.contains("closed with 1 quads")), "{:?}", q.defects);
+    assert_on_surface(&m, &q);
+}

@@ -1,7 +1,9 @@
 //! Step 6: closing the holes the trace leaves where the map is not a valid
 //! integer-grid map. The cells over flipped triangles are skipped, so the
 //! traced quads stop around them; QEx keeps tracing through such fold-overs,
-//! here the traced mesh is closed afterwards instead. Every boundary loop of
+//! here the traced mesh is closed afterwards instead. Where the traced quads
+//! are not a manifold (overlapping closings of wound cells) they are first
+//! removed, which leaves a hole too. Every boundary loop of
 //! the quads that does not run along the input's boundary is such a hole;
 //! one with an even number of sides is filled with quads whose new vertices
 //! lie on the input surface, and recorded as a defect. Odd, overlong and
@@ -35,7 +37,12 @@ const MAX_SEARCH_FACES: usize = 20_000;
 /// Fills the holes of `quads` (see the module comment), appending vertices,
 /// quads (unit-square corner UVs) and one defect per hole.
 pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
-    for hole in holes(quads) {
+    let (opened, face) = open_non_manifold(mesh, quads);
+    if opened > 0 {
+        let what = format!("{opened} quads where the traced mesh is not a manifold removed (the hole is filled)");
+        quads.defects.push(QuadDefect { face, what });
+    }
+    for hole in holes(quads).0 {
         let first = quads.locations[hole[0] as usize].face;
         let n = hole.len();
         let on_boundary = hole.iter().filter(|&&v| on_input_boundary(mesh, quads.locations[v as usize])).count();
@@ -68,10 +75,11 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
 }
 
 /// The boundary loops of `quads` as vertex cycles oriented as a face
-/// filling them would be (each side `a → b` the reverse of a quad's side).
-/// Loops through a vertex twice, or through a side two quads share in the
-/// same direction, are left out.
-fn holes(quads: &QuadMesh) -> Vec<Vec<u32>> {
+/// filling them would be (each side `a → b` the reverse of a quad's side),
+/// and the vertices where loops are not simple: loops through a vertex
+/// twice, or through a side two quads share in the same direction, are
+/// left out and their vertices listed.
+fn holes(quads: &QuadMesh) -> (Vec<Vec<u32>>, Vec<u32>) {
     let mut side_quad: HashMap<(u32, u32), usize> = HashMap::new();
     let mut broken = vec![false; quads.n_vertices()];
     for (q, quad) in quads.quads.iter().enumerate() {
@@ -107,6 +115,7 @@ fn holes(quads: &QuadMesh) -> Vec<Vec<u32>> {
     hole_sides.sort_unstable();
     let mut done: HashMap<(u32, u32), bool> = HashMap::new();
     let mut loops = Vec::new();
+    let mut pinched = Vec::new();
     for &start in &hole_sides {
         if done.contains_key(&start) {
             continue;
@@ -137,9 +146,69 @@ fn holes(quads: &QuadMesh) -> Vec<Vec<u32>> {
         sorted.dedup();
         if valid && sorted.len() == cycle.len() && cycle.len() >= 3 {
             loops.push(cycle);
+        } else {
+            pinched.extend(cycle);
         }
     }
-    loops
+    (loops, pinched)
+}
+
+/// Rounds of [`open_non_manifold`].
+const REPAIR_ROUNDS: usize = 4;
+
+/// Opens the places where the traced quads are not a manifold (two closings
+/// of cells the map winds around that overlap, or a trace that does not
+/// come back): removes every quad with a side another quad also has in
+/// the same direction (so every edge of three or more quads loses two),
+/// or through a vertex a hole's loop passes twice, until the loops are
+/// simple, so the holes left can be filled. The number of quads removed
+/// and the input face under the first.
+fn open_non_manifold(mesh: &TriMesh, quads: &mut QuadMesh) -> (usize, u32) {
+    let (mut removed, mut face) = (0, 0);
+    for _ in 0..REPAIR_ROUNDS {
+        // An edge of three or more quads has two in the same direction.
+        let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+        for q in &quads.quads {
+            for i in 0..4 {
+                *directed.entry((q[i], q[(i + 1) % 4])).or_default() += 1;
+            }
+        }
+        let bad_side = |a: u32, b: u32| a == b || directed[&(a, b)] > 1;
+        let mut bad_vertex = vec![false; quads.n_vertices()];
+        for v in holes(quads).1 {
+            // The input's own boundary may touch itself; only holes are opened.
+            if !on_input_boundary(mesh, quads.locations[v as usize]) {
+                bad_vertex[v as usize] = true;
+            }
+        }
+        let remove: Vec<bool> = quads
+            .quads
+            .iter()
+            .map(|q| (0..4).any(|i| bad_side(q[i], q[(i + 1) % 4]) || bad_vertex[q[i] as usize]))
+            .collect();
+        let count = remove.iter().filter(|&&r| r).count();
+        if count == 0 || count == quads.n_quads() {
+            break;
+        }
+        if removed == 0 {
+            let q = remove.iter().position(|&r| r).unwrap_or(0);
+            face = quads.locations[quads.quads[q][0] as usize].face;
+        }
+        let mut k = 0;
+        for q in 0..quads.n_quads() {
+            if !remove[q] {
+                quads.quads[k] = quads.quads[q];
+                for i in 0..4 {
+                    quads.uv[4 * k + i] = quads.uv[4 * q + i];
+                }
+                k += 1;
+            }
+        }
+        quads.quads.truncate(k);
+        quads.uv.truncate(4 * k);
+        removed += count;
+    }
+    (removed, face)
 }
 
 /// Number of quad edges at each vertex of `hole`.
