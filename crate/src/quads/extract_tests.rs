@@ -799,3 +799,49 @@ fn overlapping_quads_are_removed_and_the_hole_filled() {
     assert!(q.defects.iter().any(|d| d.what.contains("closed with 1 quads")), "{:?}", q.defects);
     assert_on_surface(&m, &q);
 }
+
+/// A fold next to the boundary: the hole it leaves reaches the input's
+/// boundary, and is closed with new quad vertices along that boundary, so
+/// the quad mesh is one disk with one boundary loop, every vertex on the
+/// surface and the boundary's vertices on the input's boundary.
+#[test]
+fn holes_at_the_boundary_are_filled_along_it() {
+    let n = 8;
+    let (pos, tris, mut uv) = square(n, 2 * n, 0.0, 7);
+    let m = mesh(pos.clone(), tris.clone());
+    let v = pos.iter().position(|p| p[0] == 4.0 && p[1] == 0.5).expect("grid vertex");
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            if t[k] as usize == v {
+                uv[3 * f + k] = [5.2, -0.3];
+            }
+        }
+    }
+    let q = extract(&m, &uv);
+    assert!(q.defects.iter().any(|d| d.what.contains("at the input's boundary") && d.what.contains("closed with")), "{:?}", q.defects);
+    assert!(!q.defects.iter().any(|d| d.what.contains("left open")), "{:?}", q.defects);
+    let t = topology(&q);
+    assert!(t.manifold, "{t:?}");
+    assert_eq!((t.euler, t.boundary_loops, t.unused_vertices), (1, 1, 0), "{t:?}");
+    assert_on_surface(&m, &q);
+    // Boundary vertices of the quad mesh lie on the square's boundary.
+    let mut directed = std::collections::HashSet::new();
+    for quad in &q.quads {
+        for i in 0..4 {
+            directed.insert((quad[i], quad[(i + 1) % 4]));
+        }
+    }
+    for &(a, b) in &directed {
+        if !directed.contains(&(b, a)) {
+            for w in [a, b] {
+                let p = q.positions[w as usize];
+                assert!(p[0] == 0.0 || p[0] == n as f64 || p[1] == 0.0 || p[1] == n as f64, "boundary vertex {w} at {p:?}");
+            }
+        }
+    }
+    for quad in &q.quads {
+        let p = quad.map(|v| q.positions[v as usize]);
+        let area: f64 = (0..4).map(|i| p[i][0] * p[(i + 1) % 4][1] - p[(i + 1) % 4][0] * p[i][1]).sum();
+        assert!(area > 0.0, "{quad:?} {p:?}");
+    }
+}

@@ -6,9 +6,10 @@
 //! removed, which leaves a hole too. Every boundary loop of
 //! the quads that does not run along the input's boundary is such a hole;
 //! one with an even number of sides is filled with quads whose new vertices
-//! lie on the input surface, and recorded as a defect. Odd, overlong and
-//! boundary-touching holes stay open (also recorded); a loop through a
-//! vertex twice is left as it is.
+//! lie on the input surface, and recorded as a defect; one that reaches the
+//! input's boundary is closed with new vertices along it. Odd and overlong
+//! holes stay open (also recorded); a loop through a vertex twice is left
+//! as it is.
 
 use crate::mesh::NONE;
 use crate::quads::{QuadDefect, QuadMesh, SurfacePoint};
@@ -31,6 +32,10 @@ const VALENCE_WEIGHT: f64 = 0.05;
 /// Relaxation steps of the new vertices of a filled hole.
 const SMOOTHING_STEPS: usize = 10;
 
+/// A hole at the boundary is filled only when the input's boundary between
+/// its ends is at most this many times as long as its run inside.
+const BOUNDARY_PATH_RATIO: f64 = 3.0;
+
 /// Input faces searched for the surface point nearest to a new vertex.
 const MAX_SEARCH_FACES: usize = 20_000;
 
@@ -46,31 +51,173 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
         let first = quads.locations[hole[0] as usize].face;
         let n = hole.len();
         let on_boundary = hole.iter().filter(|&&v| on_input_boundary(mesh, quads.locations[v as usize])).count();
-        let reason = if on_boundary == n {
+        if on_boundary == n {
             continue; // the input's own boundary
-        } else if on_boundary > 0 {
-            Some("it touches the input's boundary")
-        } else if n % 2 == 1 {
-            Some("it has an odd number of sides")
-        } else if n > MAX_HOLE {
-            Some("it is too long")
-        } else {
-            None
-        };
-        let what = match reason {
-            Some(why) => format!("hole of {n} quad edges where the map is invalid; left open: {why}"),
-            None => {
-                let (before, first_new) = (quads.n_quads(), quads.n_vertices());
-                let degree = corner_degrees(quads, &hole);
-                let mut patch = Patch { mesh, faces: search_faces(mesh, quads, &hole), quads, degree };
-                for q in patch.plan(&hole) {
-                    patch.push_quad(q);
-                }
-                patch.smooth(before, first_new);
-                format!("hole of {n} quad edges where the map is invalid; closed with {} quads", quads.n_quads() - before)
+        }
+        let what = if on_boundary > 0 {
+            match fill_boundary_runs(mesh, quads, &hole) {
+                Ok(added) => format!("hole of {n} quad edges at the input's boundary where the map is invalid; closed with {added} quads"),
+                Err(why) => format!("hole of {n} quad edges at the input's boundary where the map is invalid; left open: {why}"),
             }
+        } else if n % 2 == 1 {
+            format!("hole of {n} quad edges where the map is invalid; left open: it has an odd number of sides")
+        } else if n > MAX_HOLE {
+            format!("hole of {n} quad edges where the map is invalid; left open: it is too long")
+        } else {
+            format!("hole of {n} quad edges where the map is invalid; closed with {} quads", fill_polygon(mesh, quads, &hole))
         };
         quads.defects.push(QuadDefect { face: first, what });
+    }
+}
+
+/// Fills the even cycle `polygon` with quads ([`Patch::plan`]) and relaxes
+/// the vertices it creates; the number of quads added.
+fn fill_polygon(mesh: &TriMesh, quads: &mut QuadMesh, polygon: &[u32]) -> usize {
+    let before = quads.n_quads();
+    let first_new = quads.n_vertices();
+    let degree = corner_degrees(quads, polygon);
+    let mut patch = Patch { mesh, faces: search_faces(mesh, quads, polygon), quads, degree };
+    for q in patch.plan(polygon) {
+        patch.push_quad(q);
+    }
+    patch.smooth(before, first_new);
+    quads.n_quads() - before
+}
+
+/// Fills a hole that reaches the input's boundary: each run of its sides
+/// off the boundary, from boundary point `a` to boundary point `b`, and the
+/// input's boundary from `b` back to `a` (new quad vertices spaced along it
+/// so the polygon has an even number of sides) bound a polygon, filled like
+/// a hole inside. The number of quads added, or why the hole stays open.
+fn fill_boundary_runs(mesh: &TriMesh, quads: &mut QuadMesh, hole: &[u32]) -> Result<usize, &'static str> {
+    let n = hole.len();
+    let on: Vec<bool> = hole.iter().map(|&v| on_input_boundary(mesh, quads.locations[v as usize])).collect();
+    let mut runs: Vec<Vec<u32>> = Vec::new();
+    for i in (0..n).filter(|&i| on[i] && !on[(i + 1) % n]) {
+        let mut run = vec![hole[i]];
+        let mut j = (i + 1) % n;
+        while !on[j] {
+            run.push(hole[j]);
+            j = (j + 1) % n;
+        }
+        run.push(hole[j]);
+        runs.push(run);
+    }
+    let mut added = 0;
+    for run in runs {
+        let length: f64 = run.windows(2).map(|w| norm(sub(quads.positions[w[1] as usize], quads.positions[w[0] as usize]))).sum();
+        let sides = run.len() - 1;
+        let (a, b) = (run[0], run[sides]);
+        let path = boundary_path(mesh, quads.locations[b as usize], quads.locations[a as usize])
+            .ok_or("its ends are not joined along the input's boundary")?;
+        let path_length = path_length(mesh, &path);
+        if !(path_length <= BOUNDARY_PATH_RATIO * length) {
+            return Err("the input's boundary between its ends is too long");
+        }
+        // New vertices along the boundary: as many as fit at the run's
+        // mean side, with the parity that makes the polygon even.
+        let ideal = path_length / (length / sides as f64) - 1.0;
+        let m = (0..=ideal.ceil().max(1.0) as usize + 1)
+            .filter(|m| (sides + m + 1) % 2 == 0)
+            .min_by(|&x, &y| (x as f64 - ideal).abs().total_cmp(&(y as f64 - ideal).abs()))
+            .unwrap_or(1);
+        let mut polygon = run.clone();
+        for k in 1..=m {
+            let (location, p) = point_along(mesh, &path, path_length * k as f64 / (m + 1) as f64).location(mesh);
+            quads.positions.push(p);
+            quads.locations.push(location);
+            polygon.push((quads.n_vertices() - 1) as u32);
+        }
+        if polygon.len() < 4 || polygon.len() > MAX_HOLE {
+            return Err("it is too short or too long to fill");
+        }
+        added += fill_polygon(mesh, quads, &polygon);
+    }
+    Ok(added)
+}
+
+/// A point of the input's boundary: on the boundary edge of the interior
+/// half-edge `h`, at parameter `s` from its tail.
+#[derive(Clone, Copy, Debug)]
+struct BoundaryPoint {
+    h: u32,
+    s: f64,
+}
+
+impl BoundaryPoint {
+    /// Where it lies (exactly on the edge: 0 at the face's third corner).
+    fn location(self, mesh: &TriMesh) -> (SurfacePoint, V3) {
+        let k = (self.h % 3) as usize;
+        let mut bary = [0.0; 3];
+        bary[k] = 1.0 - self.s;
+        bary[(k + 1) % 3] = self.s;
+        let t = mesh.faces()[(self.h / 3) as usize].map(|v| mesh.position(v));
+        (SurfacePoint { face: self.h / 3, bary }, barycentric_point(&t, bary))
+    }
+}
+
+/// The input's boundary from the boundary point `from` to `to`, walked with
+/// the surface on the left (along the faces' half-edges): its ends and the
+/// vertices between, each as the end of the edge that reaches it. `None`
+/// when they are not on one boundary loop.
+fn boundary_path(mesh: &TriMesh, from: SurfacePoint, to: SurfacePoint) -> Option<Vec<BoundaryPoint>> {
+    let start = boundary_position(mesh, from)?;
+    let end = boundary_position(mesh, to)?;
+    let mut path = vec![start];
+    let mut h = start.h;
+    if h == end.h && end.s >= start.s {
+        path.push(end);
+        return Some(path);
+    }
+    for _ in 0..mesh.n_boundary_halfedges() {
+        path.push(BoundaryPoint { h, s: 1.0 });
+        // The next boundary edge in the faces' direction starts at head(h).
+        h = mesh.twin(mesh.prev(mesh.twin(h)));
+        if h == end.h {
+            path.push(end);
+            return Some(path);
+        }
+    }
+    None
+}
+
+/// Length of a boundary path.
+fn path_length(mesh: &TriMesh, path: &[BoundaryPoint]) -> f64 {
+    path.windows(2).map(|w| norm(sub(w[1].location(mesh).1, w[0].location(mesh).1))).sum()
+}
+
+/// The point at arc length `t` along `path`: each step runs along the edge
+/// of its second point, from the first point's parameter on that edge (0
+/// where the first ends the previous edge).
+fn point_along(mesh: &TriMesh, path: &[BoundaryPoint], t: f64) -> BoundaryPoint {
+    let mut left = t;
+    for w in path.windows(2) {
+        let l = norm(sub(w[1].location(mesh).1, w[0].location(mesh).1));
+        if left <= l && l > 0.0 {
+            let s0 = if w[0].h == w[1].h { w[0].s } else { 0.0 };
+            return BoundaryPoint { h: w[1].h, s: s0 + (w[1].s - s0) * (left / l) };
+        }
+        left -= l;
+    }
+    *path.last().expect("a path has points")
+}
+
+/// A boundary point as the interior half-edge of its boundary edge (the
+/// one leaving it when it is a vertex) and the parameter along it.
+fn boundary_position(mesh: &TriMesh, p: SurfacePoint) -> Option<BoundaryPoint> {
+    let zeros: Vec<usize> = (0..3).filter(|&k| p.bary[k] == 0.0).collect();
+    match zeros.as_slice() {
+        [k] => {
+            let h = 3 * p.face + ((*k as u32 + 1) % 3);
+            mesh.is_boundary_halfedge(mesh.twin(h)).then(|| BoundaryPoint { h, s: p.bary[(*k + 2) % 3] })
+        }
+        [i, j] => {
+            let v = mesh.faces()[p.face as usize][3 - i - j];
+            mesh.outgoing(v)
+                .find(|&h| !mesh.is_boundary_halfedge(h) && mesh.is_boundary_halfedge(mesh.twin(h)))
+                .map(|h| BoundaryPoint { h, s: 0.0 })
+        }
+        _ => None,
     }
 }
 
