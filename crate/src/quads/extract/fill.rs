@@ -55,9 +55,11 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
             continue; // the input's own boundary
         }
         let what = if on_boundary > 0 {
+            let at = format!("hole of {n} quad edges at the input's boundary where the map is invalid");
             match fill_boundary_runs(mesh, quads, &hole) {
-                Ok(added) => format!("hole of {n} quad edges at the input's boundary where the map is invalid; closed with {added} quads"),
-                Err(why) => format!("hole of {n} quad edges at the input's boundary where the map is invalid; left open: {why}"),
+                (added, None) => format!("{at}; closed with {added} quads"),
+                (0, Some(why)) => format!("{at}; left open: {why}"),
+                (added, Some(why)) => format!("{at}; partly closed with {added} quads, left open where {why}"),
             }
         } else if n % 2 == 1 {
             format!("hole of {n} quad edges where the map is invalid; left open: it has an odd number of sides")
@@ -88,8 +90,9 @@ fn fill_polygon(mesh: &TriMesh, quads: &mut QuadMesh, polygon: &[u32]) -> usize 
 /// off the boundary, from boundary point `a` to boundary point `b`, and the
 /// input's boundary from `b` back to `a` (new quad vertices spaced along it
 /// so the polygon has an even number of sides) bound a polygon, filled like
-/// a hole inside. The number of quads added, or why the hole stays open.
-fn fill_boundary_runs(mesh: &TriMesh, quads: &mut QuadMesh, hole: &[u32]) -> Result<usize, &'static str> {
+/// a hole inside. The number of quads added, and why a run stays open
+/// (the last reason, if any did).
+fn fill_boundary_runs(mesh: &TriMesh, quads: &mut QuadMesh, hole: &[u32]) -> (usize, Option<&'static str>) {
     let n = hole.len();
     let on: Vec<bool> = hole.iter().map(|&v| on_input_boundary(mesh, quads.locations[v as usize])).collect();
     let mut runs: Vec<Vec<u32>> = Vec::new();
@@ -103,37 +106,47 @@ fn fill_boundary_runs(mesh: &TriMesh, quads: &mut QuadMesh, hole: &[u32]) -> Res
         run.push(hole[j]);
         runs.push(run);
     }
-    let mut added = 0;
+    let (mut added, mut open) = (0, None);
     for run in runs {
-        let length: f64 = run.windows(2).map(|w| norm(sub(quads.positions[w[1] as usize], quads.positions[w[0] as usize]))).sum();
-        let sides = run.len() - 1;
-        let (a, b) = (run[0], run[sides]);
-        let path = boundary_path(mesh, quads.locations[b as usize], quads.locations[a as usize])
-            .ok_or("its ends are not joined along the input's boundary")?;
-        let path_length = path_length(mesh, &path);
-        if !(path_length <= BOUNDARY_PATH_RATIO * length) {
-            return Err("the input's boundary between its ends is too long");
+        match fill_run(mesh, quads, &run) {
+            Ok(k) => added += k,
+            Err(why) => open = Some(why),
         }
-        // New vertices along the boundary: as many as fit at the run's
-        // mean side, with the parity that makes the polygon even.
-        let ideal = path_length / (length / sides as f64) - 1.0;
-        let m = (0..=ideal.ceil().max(1.0) as usize + 1)
-            .filter(|m| (sides + m + 1) % 2 == 0)
-            .min_by(|&x, &y| (x as f64 - ideal).abs().total_cmp(&(y as f64 - ideal).abs()))
-            .unwrap_or(1);
-        let mut polygon = run.clone();
-        for k in 1..=m {
-            let (location, p) = point_along(mesh, &path, path_length * k as f64 / (m + 1) as f64).location(mesh);
-            quads.positions.push(p);
-            quads.locations.push(location);
-            polygon.push((quads.n_vertices() - 1) as u32);
-        }
-        if polygon.len() < 4 || polygon.len() > MAX_HOLE {
-            return Err("it is too short or too long to fill");
-        }
-        added += fill_polygon(mesh, quads, &polygon);
     }
-    Ok(added)
+    (added, open)
+}
+
+/// Closes the hole between the run of hole sides `run` (from boundary point
+/// to boundary point) and the input's boundary back from its end to its
+/// start ([`fill_boundary_runs`]).
+fn fill_run(mesh: &TriMesh, quads: &mut QuadMesh, run: &[u32]) -> Result<usize, &'static str> {
+    let length: f64 = run.windows(2).map(|w| norm(sub(quads.positions[w[1] as usize], quads.positions[w[0] as usize]))).sum();
+    let sides = run.len() - 1;
+    let (a, b) = (run[0], run[sides]);
+    let path = boundary_path(mesh, quads.locations[b as usize], quads.locations[a as usize])
+        .ok_or("its ends are not joined along the input's boundary")?;
+    let path_length = path_length(mesh, &path);
+    if !(path_length <= BOUNDARY_PATH_RATIO * length) {
+        return Err("the input's boundary between its ends is too long");
+    }
+    // New vertices along the boundary: as many as fit at the run's
+    // mean side, with the parity that makes the polygon even.
+    let ideal = path_length / (length / sides as f64) - 1.0;
+    let m = (0..=ideal.ceil().max(1.0) as usize + 1)
+        .filter(|m| (sides + m + 1) % 2 == 0)
+        .min_by(|&x, &y| (x as f64 - ideal).abs().total_cmp(&(y as f64 - ideal).abs()))
+        .unwrap_or(1);
+    let mut polygon = run.to_vec();
+    for k in 1..=m {
+        let (location, p) = point_along(mesh, &path, path_length * k as f64 / (m + 1) as f64).location(mesh);
+        quads.positions.push(p);
+        quads.locations.push(location);
+        polygon.push((quads.n_vertices() - 1) as u32);
+    }
+    if polygon.len() < 4 || polygon.len() > MAX_HOLE {
+        return Err("it is too short or too long to fill");
+    }
+    Ok(fill_polygon(mesh, quads, &polygon))
 }
 
 /// A point of the input's boundary: on the boundary edge of the interior
