@@ -11,33 +11,23 @@
 //! holes stay open (also recorded); a loop through a vertex twice is left
 //! as it is.
 
-use crate::mesh::NONE;
+mod boundary;
+mod patch;
+
 use crate::quads::{QuadDefect, QuadMesh, SurfacePoint};
-use crate::vec3::{add, barycentric_point, closest_point_barycentric, cross, dot, norm, scale, sub, V3};
+use crate::vec3::{norm, sub};
 use crate::TriMesh;
+use boundary::{boundary_path, path_length, point_along};
+use patch::fill_polygon;
 use std::collections::HashMap;
 
 /// Holes longer than this are left open (the map is broken over a region
 /// too large to patch plausibly).
 const MAX_HOLE: usize = 64;
 
-/// Cuts tried per hole of 6 to 16 sides (the shortest ones; longer holes
-/// take the shortest cut only, which bounds the search).
-const CUTS_TRIED: usize = 3;
-
-/// Weight of a unit of valence away from 4 against the sine of the worst
-/// corner angle, in [`Patch::score`].
-const VALENCE_WEIGHT: f64 = 0.05;
-
-/// Relaxation steps of the new vertices of a filled hole.
-const SMOOTHING_STEPS: usize = 10;
-
 /// A hole at the boundary is filled only when the input's boundary between
 /// its ends is at most this many times as long as its run inside.
 const BOUNDARY_PATH_RATIO: f64 = 3.0;
-
-/// Input faces searched for the surface point nearest to a new vertex.
-const MAX_SEARCH_FACES: usize = 20_000;
 
 /// Fills the holes of `quads` (see the module comment), appending vertices,
 /// quads (unit-square corner UVs) and one defect per hole.
@@ -70,20 +60,6 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
         };
         quads.defects.push(QuadDefect { face: first, what });
     }
-}
-
-/// Fills the even cycle `polygon` with quads ([`Patch::plan`]) and relaxes
-/// the vertices it creates; the number of quads added.
-fn fill_polygon(mesh: &TriMesh, quads: &mut QuadMesh, polygon: &[u32]) -> usize {
-    let before = quads.n_quads();
-    let first_new = quads.n_vertices();
-    let degree = corner_degrees(quads, polygon);
-    let mut patch = Patch { mesh, faces: search_faces(mesh, quads, polygon), quads, degree };
-    for q in patch.plan(polygon) {
-        patch.push_quad(q);
-    }
-    patch.smooth(before, first_new);
-    quads.n_quads() - before
 }
 
 /// Fills a hole that reaches the input's boundary: each run of its sides
@@ -147,91 +123,6 @@ fn fill_run(mesh: &TriMesh, quads: &mut QuadMesh, run: &[u32]) -> Result<usize, 
         return Err("it is too short or too long to fill");
     }
     Ok(fill_polygon(mesh, quads, &polygon))
-}
-
-/// A point of the input's boundary: on the boundary edge of the interior
-/// half-edge `h`, at parameter `s` from its tail.
-#[derive(Clone, Copy, Debug)]
-struct BoundaryPoint {
-    h: u32,
-    s: f64,
-}
-
-impl BoundaryPoint {
-    /// Where it lies (exactly on the edge: 0 at the face's third corner).
-    fn location(self, mesh: &TriMesh) -> (SurfacePoint, V3) {
-        let k = (self.h % 3) as usize;
-        let mut bary = [0.0; 3];
-        bary[k] = 1.0 - self.s;
-        bary[(k + 1) % 3] = self.s;
-        let t = mesh.faces()[(self.h / 3) as usize].map(|v| mesh.position(v));
-        (SurfacePoint { face: self.h / 3, bary }, barycentric_point(&t, bary))
-    }
-}
-
-/// The input's boundary from the boundary point `from` to `to`, walked with
-/// the surface on the left (along the faces' half-edges): its ends and the
-/// vertices between, each as the end of the edge that reaches it. `None`
-/// when they are not on one boundary loop.
-fn boundary_path(mesh: &TriMesh, from: SurfacePoint, to: SurfacePoint) -> Option<Vec<BoundaryPoint>> {
-    let start = boundary_position(mesh, from)?;
-    let end = boundary_position(mesh, to)?;
-    let mut path = vec![start];
-    let mut h = start.h;
-    if h == end.h && end.s >= start.s {
-        path.push(end);
-        return Some(path);
-    }
-    for _ in 0..mesh.n_boundary_halfedges() {
-        path.push(BoundaryPoint { h, s: 1.0 });
-        // The next boundary edge in the faces' direction starts at head(h).
-        h = mesh.twin(mesh.prev(mesh.twin(h)));
-        if h == end.h {
-            path.push(end);
-            return Some(path);
-        }
-    }
-    None
-}
-
-/// Length of a boundary path.
-fn path_length(mesh: &TriMesh, path: &[BoundaryPoint]) -> f64 {
-    path.windows(2).map(|w| norm(sub(w[1].location(mesh).1, w[0].location(mesh).1))).sum()
-}
-
-/// The point at arc length `t` along `path`: each step runs along the edge
-/// of its second point, from the first point's parameter on that edge (0
-/// where the first ends the previous edge).
-fn point_along(mesh: &TriMesh, path: &[BoundaryPoint], t: f64) -> BoundaryPoint {
-    let mut left = t;
-    for w in path.windows(2) {
-        let l = norm(sub(w[1].location(mesh).1, w[0].location(mesh).1));
-        if left <= l && l > 0.0 {
-            let s0 = if w[0].h == w[1].h { w[0].s } else { 0.0 };
-            return BoundaryPoint { h: w[1].h, s: s0 + (w[1].s - s0) * (left / l) };
-        }
-        left -= l;
-    }
-    *path.last().expect("a path has points")
-}
-
-/// A boundary point as the interior half-edge of its boundary edge (the
-/// one leaving it when it is a vertex) and the parameter along it.
-fn boundary_position(mesh: &TriMesh, p: SurfacePoint) -> Option<BoundaryPoint> {
-    let zeros: Vec<usize> = (0..3).filter(|&k| p.bary[k] == 0.0).collect();
-    match zeros.as_slice() {
-        [k] => {
-            let h = 3 * p.face + ((*k as u32 + 1) % 3);
-            mesh.is_boundary_halfedge(mesh.twin(h)).then(|| BoundaryPoint { h, s: p.bary[(*k + 2) % 3] })
-        }
-        [i, j] => {
-            let v = mesh.faces()[p.face as usize][3 - i - j];
-            mesh.outgoing(v)
-                .find(|&h| !mesh.is_boundary_halfedge(h) && mesh.is_boundary_halfedge(mesh.twin(h)))
-                .map(|h| BoundaryPoint { h, s: 0.0 })
-        }
-        _ => None,
-    }
 }
 
 /// The boundary loops of `quads` as vertex cycles oriented as a face
@@ -371,28 +262,6 @@ fn open_non_manifold(mesh: &TriMesh, quads: &mut QuadMesh) -> (usize, u32) {
     (removed, face)
 }
 
-/// Number of quad edges at each vertex of `hole`.
-fn corner_degrees(quads: &QuadMesh, hole: &[u32]) -> HashMap<u32, usize> {
-    let mut neighbours: HashMap<u32, Vec<u32>> = hole.iter().map(|&v| (v, Vec::new())).collect();
-    for q in &quads.quads {
-        for i in 0..4 {
-            for (a, b) in [(q[i], q[(i + 1) % 4]), (q[(i + 1) % 4], q[i])] {
-                if let Some(list) = neighbours.get_mut(&a) {
-                    list.push(b);
-                }
-            }
-        }
-    }
-    neighbours
-        .into_iter()
-        .map(|(v, mut list)| {
-            list.sort_unstable();
-            list.dedup();
-            (v, list.len())
-        })
-        .collect()
-}
-
 /// Whether a quad vertex lies on a boundary edge or vertex of the input.
 fn on_input_boundary(mesh: &TriMesh, p: SurfacePoint) -> bool {
     let zeros: Vec<usize> = (0..3).filter(|&k| p.bary[k] == 0.0).collect();
@@ -405,211 +274,6 @@ fn on_input_boundary(mesh: &TriMesh, p: SurfacePoint) -> bool {
         }
         [i, j] => mesh.is_boundary_vertex(corners[3 - i - j]),
         _ => false,
-    }
-}
-
-/// The input faces near a hole: rings grown from the faces of its
-/// vertices' locations, as many rings as the hole has sides (the hole's
-/// interior lies within), at most [`MAX_SEARCH_FACES`].
-fn search_faces(mesh: &TriMesh, quads: &QuadMesh, hole: &[u32]) -> Vec<u32> {
-    let mut seen = vec![false; mesh.n_faces()];
-    let mut faces: Vec<u32> = Vec::new();
-    for &v in hole {
-        let f = quads.locations[v as usize].face;
-        if !std::mem::replace(&mut seen[f as usize], true) {
-            faces.push(f);
-        }
-    }
-    let mut start = 0;
-    for _ in 0..hole.len() {
-        let end = faces.len();
-        for i in start..end {
-            for v in mesh.faces()[faces[i] as usize] {
-                for g in mesh.vertex_faces(v) {
-                    if g != NONE && !std::mem::replace(&mut seen[g as usize], true) {
-                        faces.push(g);
-                    }
-                }
-            }
-        }
-        start = end;
-        if start == faces.len() || faces.len() > MAX_SEARCH_FACES {
-            break;
-        }
-    }
-    faces
-}
-
-/// A hole being filled: the quads it adds to and the input faces its new
-/// vertices are placed on.
-struct Patch<'a> {
-    mesh: &'a TriMesh,
-    faces: Vec<u32>,
-    quads: &'a mut QuadMesh,
-    /// Quad edges at each corner of the hole before it is filled.
-    degree: HashMap<u32, usize>,
-}
-
-impl Patch<'_> {
-    fn position(&self, v: u32) -> V3 {
-        self.quads.positions[v as usize]
-    }
-
-    /// The point of the searched input faces nearest to `x`.
-    fn nearest(&self, x: V3) -> (SurfacePoint, V3) {
-        let mut best = (f64::INFINITY, SurfacePoint { face: 0, bary: [1.0, 0.0, 0.0] }, x);
-        for &f in &self.faces {
-            let t = self.mesh.faces()[f as usize].map(|v| self.mesh.position(v));
-            let bary = closest_point_barycentric(x, &t);
-            let p = barycentric_point(&t, bary);
-            let d = norm(sub(p, x));
-            if d < best.0 {
-                best = (d, SurfacePoint { face: f, bary }, p);
-            }
-        }
-        (best.1, best.2)
-    }
-
-    /// A new quad vertex at the point of the input nearest to `x`.
-    fn vertex_near(&mut self, x: V3) -> u32 {
-        let (location, p) = self.nearest(x);
-        self.quads.positions.push(p);
-        self.quads.locations.push(location);
-        (self.quads.positions.len() - 1) as u32
-    }
-
-    /// Relaxes the new vertices (`first_new..`) of the quads `first_quad..`:
-    /// each moves to the mean of its quad-edge neighbours, then back onto
-    /// the input surface, [`SMOOTHING_STEPS`] times.
-    fn smooth(&mut self, first_quad: usize, first_new: usize) {
-        let n_new = self.quads.n_vertices() - first_new;
-        if n_new == 0 {
-            return;
-        }
-        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n_new];
-        for q in &self.quads.quads[first_quad..] {
-            for i in 0..4 {
-                let (a, b) = (q[i] as usize, q[(i + 1) % 4]);
-                if a >= first_new {
-                    neighbours[a - first_new].push(b);
-                }
-                let (a, b) = (q[(i + 1) % 4] as usize, q[i]);
-                if a >= first_new {
-                    neighbours[a - first_new].push(b);
-                }
-            }
-        }
-        for _ in 0..SMOOTHING_STEPS {
-            for (i, nb) in neighbours.iter().enumerate() {
-                if nb.is_empty() {
-                    continue;
-                }
-                let mean = scale(nb.iter().fold([0.0; 3], |s, &v| add(s, self.position(v))), 1.0 / nb.len() as f64);
-                let (location, p) = self.nearest(mean);
-                self.quads.positions[first_new + i] = p;
-                self.quads.locations[first_new + i] = location;
-            }
-        }
-    }
-
-    fn push_quad(&mut self, q: [u32; 4]) {
-        self.quads.quads.push(q);
-        self.quads.uv.extend([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
-    }
-
-    /// The quads filling the even cycle `hole` (oriented as its filling
-    /// faces): the best-scored ([`Patch::score`]) of one quad (4 sides), a
-    /// fan around a new centre vertex (6 and 8 sides), and cuts into two
-    /// shorter holes by a diagonal or a chain of new vertices between two
-    /// corners, each filled in turn. Candidate vertices not used stay
-    /// unreferenced (dropped after all holes are filled).
-    fn plan(&mut self, hole: &[u32]) -> Vec<[u32; 4]> {
-        let n = hole.len();
-        if n == 4 {
-            return vec![[hole[0], hole[1], hole[2], hole[3]]];
-        }
-        let x: Vec<V3> = hole.iter().map(|&v| self.position(v)).collect();
-        let dist = |i: usize, j: usize| norm(sub(x[i % n], x[j % n]));
-        let mean_side = (0..n).map(|i| dist(i, i + 1)).sum::<f64>() / n as f64;
-        let mut candidates: Vec<Vec<[u32; 4]>> = Vec::new();
-        if n <= 8 {
-            let centre = scale(x.iter().fold([0.0; 3], |s, &p| add(s, p)), 1.0 / n as f64);
-            let m = self.vertex_near(centre);
-            for offset in 0..2 {
-                let c = |d: usize| hole[(offset + d) % n];
-                candidates.push((0..n).step_by(2).map(|k| [c(k), c(k + 1), c(k + 2), m]).collect());
-            }
-        }
-        // Cuts from corner i to corner i + k by a chain of p sides: holes of
-        // k + p and n − k + p sides, both even and shorter than n; the
-        // shortest few (chain length near the corners' distance) are tried.
-        let mut cuts: Vec<(f64, usize, usize, usize)> = Vec::new();
-        for i in 0..n {
-            for k in (n / 2).saturating_sub(1).max(2)..=(n / 2 + 1).min(n - 2) {
-                let ideal = dist(i, i + k) / mean_side.max(f64::MIN_POSITIVE);
-                let limit = k.min(n - k) - 1;
-                let p = (1..=limit)
-                    .filter(|p| (k + p) % 2 == 0)
-                    .min_by(|&a, &b| (a as f64 - ideal).abs().total_cmp(&(b as f64 - ideal).abs()));
-                if let Some(p) = p {
-                    cuts.push((dist(i, i + k) + mean_side * (p as f64 - ideal).abs(), i, k, p));
-                }
-            }
-        }
-        cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let tried = if n <= 16 { CUTS_TRIED } else { 1 };
-        for &(_, i, k, p) in cuts.iter().take(tried) {
-            let (a, b) = (x[i], x[(i + k) % n]);
-            let chain: Vec<u32> =
-                (1..p).map(|s| self.vertex_near(add(a, scale(sub(b, a), s as f64 / p as f64)))).collect();
-            let c = |d: usize| hole[(i + d) % n];
-            let first: Vec<u32> = (0..=k).map(c).chain(chain.iter().rev().copied()).collect();
-            let second: Vec<u32> = (k..=n).map(c).chain(chain.iter().copied()).collect();
-            let mut quads = self.plan(&first);
-            quads.extend(self.plan(&second));
-            candidates.push(quads);
-        }
-        candidates.into_iter().max_by(|a, b| self.score(hole, a).total_cmp(&self.score(hole, b))).unwrap_or_default()
-    }
-
-    /// How good a filling of `hole` by `quads` is: its worst corner (the
-    /// sine of the corner angle, negative where a quad folds), less a
-    /// penalty for vertices whose valence it takes away from 4.
-    fn score(&self, hole: &[u32], quads: &[[u32; 4]]) -> f64 {
-        let mut worst = f64::INFINITY;
-        let mut edges: Vec<(u32, u32)> = Vec::new();
-        for q in quads {
-            let p = q.map(|v| self.position(v));
-            let normal = (0..4).fold([0.0; 3], |s, i| add(s, cross(p[i], p[(i + 1) % 4])));
-            let ln = norm(normal);
-            for i in 0..4 {
-                let (e0, e1) = (sub(p[i], p[(i + 3) % 4]), sub(p[(i + 1) % 4], p[i]));
-                let l = norm(e0) * norm(e1) * ln;
-                let sine = if l > 0.0 { dot(cross(e0, e1), normal) / l } else { -1.0 };
-                worst = worst.min(sine);
-                let (a, b) = (q[i], q[(i + 1) % 4]);
-                edges.push((a.min(b), a.max(b)));
-            }
-        }
-        edges.sort_unstable();
-        edges.dedup();
-        let mut degree: HashMap<u32, usize> = HashMap::new();
-        let n = hole.len();
-        for &(a, b) in &edges {
-            let side = (0..n).any(|i| (hole[i], hole[(i + 1) % n]) == (a, b) || (hole[i], hole[(i + 1) % n]) == (b, a));
-            if !side {
-                *degree.entry(a).or_default() += 1;
-                *degree.entry(b).or_default() += 1;
-            }
-        }
-        let valence_cost: f64 = degree
-            .iter()
-            .map(|(v, &added)| {
-                let before = self.degree.get(v).copied().unwrap_or(0) as f64;
-                (before + added as f64 - 4.0).abs() - if self.degree.contains_key(v) { (before - 4.0).abs() } else { 0.0 }
-            })
-            .sum();
-        worst - VALENCE_WEIGHT * valence_cost
     }
 }
 
