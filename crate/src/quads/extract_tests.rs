@@ -179,6 +179,18 @@ fn odd_cell(t: [u32; 3]) -> [u32; 3] {
     }
 }
 
+/// Sets the UV of every corner at vertex `v` to `to` (a fold when `to` lies
+/// outside the vertex's one-ring).
+fn move_uv(tris: &[[u32; 3]], uv: &mut [[f64; 2]], v: u32, to: [f64; 2]) {
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            if t[k] == v {
+                uv[3 * f + k] = to;
+            }
+        }
+    }
+}
+
 fn mesh(pos: Vec<[f64; 3]>, tris: Vec<[u32; 3]>) -> TriMesh {
     TriMesh::from_welded_arrays(pos, tris).expect("test mesh is valid")
 }
@@ -591,17 +603,31 @@ fn flipped_triangles_are_defects_not_panics() {
     let m = mesh(pos.clone(), tris.clone());
     // Move vertex (2, 2) far outside its one-ring in every corner.
     let v = 2 * 5 + 2;
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            if t[k] == v {
-                uv[3 * f + k] = [3.7, 2.4];
-            }
-        }
-    }
+    move_uv(&tris, &mut uv, v, [3.7, 2.4]);
     let q = extract(&m, &uv);
     assert!(q.defects.iter().any(|d| d.what.contains("flipped")), "{:?}", q.defects);
     let t = topology(&q);
     assert!(t.manifold, "{t:?}");
+}
+
+/// The square [0, 8]² (16 × 16 grid) with the grid vertex at `at` moved
+/// to `to` in the map, and its extracted quads.
+fn folded_square(at: [f64; 2], to: [f64; 2]) -> (TriMesh, QuadMesh) {
+    let (pos, tris, mut uv) = square(8, 16, 0.0, 3);
+    let m = mesh(pos.clone(), tris.clone());
+    let v = pos.iter().position(|p| p[0] == at[0] && p[1] == at[1]).expect("grid vertex");
+    move_uv(&tris, &mut uv, v as u32, to);
+    let q = extract(&m, &uv);
+    (m, q)
+}
+
+/// Filled quads are not folded: each has a positive area in the plane.
+fn assert_positive_areas(q: &QuadMesh) {
+    for quad in &q.quads {
+        let p = quad.map(|v| q.positions[v as usize]);
+        let area: f64 = (0..4).map(|i| p[i][0] * p[(i + 1) % 4][1] - p[(i + 1) % 4][0] * p[i][1]).sum();
+        assert!(area > 0.0, "{quad:?} {p:?}");
+    }
 }
 
 /// A square map whose middle folds: the cells over the flipped triangles are
@@ -609,19 +635,8 @@ fn flipped_triangles_are_defects_not_panics() {
 /// the quad mesh is still one watertight disk.
 #[test]
 fn holes_over_flipped_triangles_are_filled() {
-    let n = 8;
-    let (pos, tris, mut uv) = square(n, 2 * n, 0.0, 3);
-    let m = mesh(pos.clone(), tris.clone());
     // Push the vertex at (4, 4) across its neighbours.
-    let centre = pos.iter().position(|p| p[0] == 4.0 && p[1] == 4.0).expect("grid vertex");
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            if t[k] as usize == centre {
-                uv[3 * f + k] = [5.3, 4.6];
-            }
-        }
-    }
-    let q = extract(&m, &uv);
+    let (m, q) = folded_square([4.0, 4.0], [5.3, 4.6]);
     assert!(q.defects.iter().any(|d| d.what.contains("flipped")), "{:?}", q.defects);
     let filled: Vec<&QuadDefect> = q.defects.iter().filter(|d| d.what.contains("closed with")).collect();
     assert!(!filled.is_empty(), "{:?}", q.defects);
@@ -631,12 +646,7 @@ fn holes_over_flipped_triangles_are_filled() {
     assert_eq!((t.euler, t.boundary_loops, t.unused_vertices), (1, 1, 0), "{t:?}");
     assert_on_surface(&m, &q);
     assert_unit_squares(&q);
-    // Filled quads are not folded: each has a positive area in the plane.
-    for quad in &q.quads {
-        let p = quad.map(|v| q.positions[v as usize]);
-        let area: f64 = (0..4).map(|i| p[i][0] * p[(i + 1) % 4][1] - p[(i + 1) % 4][0] * p[i][1]).sum();
-        assert!(area > 0.0, "{quad:?} {p:?}");
-    }
+    assert_positive_areas(&q);
 }
 
 #[test]
@@ -806,18 +816,8 @@ fn overlapping_quads_are_removed_and_the_hole_filled() {
 /// surface and the boundary's vertices on the input's boundary.
 #[test]
 fn holes_at_the_boundary_are_filled_along_it() {
-    let n = 8;
-    let (pos, tris, mut uv) = square(n, 2 * n, 0.0, 7);
-    let m = mesh(pos.clone(), tris.clone());
-    let v = pos.iter().position(|p| p[0] == 4.0 && p[1] == 0.5).expect("grid vertex");
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            if t[k] as usize == v {
-                uv[3 * f + k] = [5.2, -0.3];
-            }
-        }
-    }
-    let q = extract(&m, &uv);
+    let n = 8.0;
+    let (m, q) = folded_square([4.0, 0.5], [5.2, -0.3]);
     assert!(q.defects.iter().any(|d| d.what.contains("at the input's boundary") && d.what.contains("closed with")), "{:?}", q.defects);
     assert!(!q.defects.iter().any(|d| d.what.contains("left open")), "{:?}", q.defects);
     let t = topology(&q);
@@ -835,13 +835,9 @@ fn holes_at_the_boundary_are_filled_along_it() {
         if !directed.contains(&(b, a)) {
             for w in [a, b] {
                 let p = q.positions[w as usize];
-                assert!(p[0] == 0.0 || p[0] == n as f64 || p[1] == 0.0 || p[1] == n as f64, "boundary vertex {w} at {p:?}");
+                assert!(p[0] == 0.0 || p[0] == n || p[1] == 0.0 || p[1] == n, "boundary vertex {w} at {p:?}");
             }
         }
     }
-    for quad in &q.quads {
-        let p = quad.map(|v| q.positions[v as usize]);
-        let area: f64 = (0..4).map(|i| p[i][0] * p[(i + 1) % 4][1] - p[(i + 1) % 4][0] * p[i][1]).sum();
-        assert!(area > 0.0, "{quad:?} {p:?}");
-    }
+    assert_positive_areas(&q);
 }
