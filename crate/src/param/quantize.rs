@@ -468,8 +468,14 @@ impl Quantizer {
     ) -> Result<IntegerGridMap, QuantizeError> {
         let mut clock = Stopwatch::start();
         let s = self.grid_length(size)?;
-        let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
-        let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
+        // The seamless map in units of the grid length `s`, and its Jacobians
+        // (the fit's targets).
+        let start = |s: f64| {
+            let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
+            let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
+            (x0, targets)
+        };
+        let (x0, targets) = start(s);
         // Rounded with the uniform fit, and where that leaves the map bad,
         // again with the faces around singular points stiffer; the best is kept.
         let stiff = self.stiff_faces(&x0);
@@ -498,8 +504,7 @@ impl Quantizer {
                     break;
                 }
                 let s_retry = s * factor;
-                let x0: Vec<f64> = self.seamless.iter().map(|v| v / s_retry).collect();
-                let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
+                let (x0, targets) = start(s_retry);
                 let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, progress)?;
                 if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
                     best = Some((rounded, s_retry));

@@ -17,9 +17,9 @@ mod patch;
 use crate::quads::{QuadDefect, QuadMesh, SurfacePoint};
 use crate::vec3::{norm, sub};
 use crate::TriMesh;
-use boundary::{boundary_path, path_length, point_along};
+use boundary::{boundary_path, boundary_position, path_length, point_along};
 use patch::fill_polygon;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Holes longer than this are left open (the map is broken over a region
 /// too large to patch plausibly).
@@ -40,13 +40,14 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
     for hole in holes(quads).0 {
         let first = quads.locations[hole[0] as usize].face;
         let n = hole.len();
-        let on_boundary = hole.iter().filter(|&&v| on_input_boundary(mesh, quads.locations[v as usize])).count();
+        let on: Vec<bool> = hole.iter().map(|&v| on_input_boundary(mesh, quads.locations[v as usize])).collect();
+        let on_boundary = on.iter().filter(|&&b| b).count();
         if on_boundary == n {
             continue; // the input's own boundary
         }
         let what = if on_boundary > 0 {
             let at = format!("hole of {n} quad edges at the input's boundary where the map is invalid");
-            match fill_boundary_runs(mesh, quads, &hole) {
+            match fill_boundary_runs(mesh, quads, &hole, &on) {
                 (added, None) => format!("{at}; closed with {added} quads"),
                 (0, Some(why)) => format!("{at}; left open: {why}"),
                 (added, Some(why)) => format!("{at}; partly closed with {added} quads, left open where {why}"),
@@ -62,15 +63,15 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
     }
 }
 
-/// Fills a hole that reaches the input's boundary: each run of its sides
+/// Fills a hole that reaches the input's boundary (`on`: which of its
+/// vertices lie on that boundary): each run of its sides
 /// off the boundary, from boundary point `a` to boundary point `b`, and the
 /// input's boundary from `b` back to `a` (new quad vertices spaced along it
 /// so the polygon has an even number of sides) bound a polygon, filled like
 /// a hole inside. The number of quads added, and why a run stays open
 /// (the last reason, if any did).
-fn fill_boundary_runs(mesh: &TriMesh, quads: &mut QuadMesh, hole: &[u32]) -> (usize, Option<&'static str>) {
+fn fill_boundary_runs(mesh: &TriMesh, quads: &mut QuadMesh, hole: &[u32], on: &[bool]) -> (usize, Option<&'static str>) {
     let n = hole.len();
-    let on: Vec<bool> = hole.iter().map(|&v| on_input_boundary(mesh, quads.locations[v as usize])).collect();
     let mut runs: Vec<Vec<u32>> = Vec::new();
     for i in (0..n).filter(|&i| on[i] && !on[(i + 1) % n]) {
         let mut run = vec![hole[i]];
@@ -164,18 +165,18 @@ fn holes(quads: &QuadMesh) -> (Vec<Vec<u32>>, Vec<u32>) {
     let mut hole_sides: Vec<(u32, u32)> =
         side_quad.keys().filter(|&&(a, b)| !side_quad.contains_key(&(b, a))).map(|&(a, b)| (b, a)).collect();
     hole_sides.sort_unstable();
-    let mut done: HashMap<(u32, u32), bool> = HashMap::new();
+    let mut done: HashSet<(u32, u32)> = HashSet::new();
     let mut loops = Vec::new();
     let mut pinched = Vec::new();
     for &start in &hole_sides {
-        if done.contains_key(&start) {
+        if done.contains(&start) {
             continue;
         }
         let mut cycle = vec![start.0];
         let mut side = start;
         let mut valid = !broken[start.0 as usize];
         loop {
-            done.insert(side, true);
+            done.insert(side);
             let (b, a) = side;
             let Some(z) = next(a, b) else {
                 valid = false;
@@ -185,7 +186,7 @@ fn holes(quads: &QuadMesh) -> (Vec<Vec<u32>>, Vec<u32>) {
             if side == start {
                 break;
             }
-            if done.contains_key(&side) || cycle.len() > 4 * quads.n_quads() {
+            if done.contains(&side) || cycle.len() > 4 * quads.n_quads() {
                 valid = false;
                 break;
             }
@@ -264,16 +265,5 @@ fn open_non_manifold(mesh: &TriMesh, quads: &mut QuadMesh) -> (usize, u32) {
 
 /// Whether a quad vertex lies on a boundary edge or vertex of the input.
 fn on_input_boundary(mesh: &TriMesh, p: SurfacePoint) -> bool {
-    let zeros: Vec<usize> = (0..3).filter(|&k| p.bary[k] == 0.0).collect();
-    let corners = mesh.faces()[p.face as usize];
-    match zeros.as_slice() {
-        [k] => {
-            // The edge opposite corner k: its half-edge runs from corner k + 1.
-            let h = 3 * p.face + ((*k as u32 + 1) % 3);
-            mesh.is_boundary_halfedge(mesh.twin(h))
-        }
-        [i, j] => mesh.is_boundary_vertex(corners[3 - i - j]),
-        _ => false,
-    }
+    boundary_position(mesh, p).is_some()
 }
-

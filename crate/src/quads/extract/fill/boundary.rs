@@ -73,8 +73,9 @@ pub(super) fn point_along(mesh: &TriMesh, path: &[BoundaryPoint], t: f64) -> Bou
 }
 
 /// A boundary point as the interior half-edge of its boundary edge (the
-/// one leaving it when it is a vertex) and the parameter along it.
-fn boundary_position(mesh: &TriMesh, p: SurfacePoint) -> Option<BoundaryPoint> {
+/// one leaving it when it is a vertex) and the parameter along it; `None`
+/// for a point off the input's boundary.
+pub(super) fn boundary_position(mesh: &TriMesh, p: SurfacePoint) -> Option<BoundaryPoint> {
     let zeros: Vec<usize> = (0..3).filter(|&k| p.bary[k] == 0.0).collect();
     match zeros.as_slice() {
         [k] => {

@@ -220,7 +220,8 @@ impl Patch<'_> {
             quads.extend(self.plan(&second));
             candidates.push(quads);
         }
-        candidates.into_iter().max_by(|a, b| self.score(hole, a).total_cmp(&self.score(hole, b))).unwrap_or_default()
+        let scored: Vec<(f64, Vec<[u32; 4]>)> = candidates.into_iter().map(|c| (self.score(hole, &c), c)).collect();
+        scored.into_iter().max_by(|a, b| a.0.total_cmp(&b.0)).map(|(_, c)| c).unwrap_or_default()
     }
 
     /// How good a filling of `hole` by `quads` is: its worst corner (the
