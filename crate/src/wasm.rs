@@ -8,7 +8,7 @@ use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::quantize::{GridSize, QuantizeReport, Quantizer};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
 use crate::quads::{self, check_quads, extract_quads, CheckOptions, ExtractOptions, QuadReport};
-use crate::pipeline::{ConeStage, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
+use crate::pipeline::{self, ConeStage, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
 use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -74,16 +74,24 @@ pub struct MeshSession {
     boundary: BoundaryMode,
 }
 
-/// A solved map and its quantizer: changing the quad count re-runs only
-/// quantization and extraction.
+/// The map quads are traced on and its quantizer: changing the quad count
+/// re-runs only quantization and extraction.
 struct GridStage {
+    /// The last solve's map; for a mesh whose edges are longer than a quad
+    /// mesh wants ([`pipeline::quads_refine`]), replaced on the first quads
+    /// request by the map solved on its refinement.
     solution: Solution<'static>,
     quantizer: Option<Quantizer>,
+    /// The solve's features and settings, to solve again on the refinement.
+    features: FeatureSet,
+    options: SolveOptions,
 }
 
-/// A solve run in steps: its features, its cone stage and the components placed so far.
+/// A solve run in steps: its features and settings, its cone stage and the
+/// components placed so far.
 struct Job {
     features: FeatureSet,
+    options: SolveOptions,
     stage: ConeStage,
     placed: Vec<ComponentPlacement>,
 }
@@ -251,9 +259,10 @@ impl MeshSession {
         self.job = None;
         self.grid = None;
         let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
-        let stage = ConeStage::new(mesh, &features, &SolveOptions { cones, param: ParamOptions::default(), refine: self.refine });
+        let options = SolveOptions { cones, param: ParamOptions::default(), refine: self.refine };
+        let stage = ConeStage::new(mesh, &features, &options);
         let schedule = stage.problem().schedule().iter().map(|&c| c as u32).collect();
-        self.job = Some(Job { features, stage, placed: Vec::new() });
+        self.job = Some(Job { features, options, stage, placed: Vec::new() });
         Ok(schedule)
     }
 
@@ -288,23 +297,13 @@ impl MeshSession {
     /// solve error's message and, where it names mesh elements, `location:
     /// {vertices: number[], edges: number[]}` in input ids ([`solve_error`]).
     pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsValue> {
-        let Job { features, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
+        let Job { features, options, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
         let mesh = self.valid_mesh()?;
         let fail = |e: SolveError| solve_error(&e);
         let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
-        let mut report = |p: SolveProgress| {
-            let (stage, a, b, fraction) = match p {
-                SolveProgress::Cones(c) => cone_stage(&c),
-                SolveProgress::Param(p) => {
-                    let (stage, a, b) = param_stage(&p);
-                    (stage, a, b, None)
-                }
-            };
-            notify(progress, stage, a, b, fraction);
-        };
-        let sol = placed.parametrize(mesh, &features, &mut report).map_err(fail)?;
+        let sol = placed.parametrize(mesh, &features, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
-        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None });
+        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None, features, options });
         Ok(result)
     }
 
@@ -313,7 +312,15 @@ impl MeshSession {
     /// quantization and extraction. Throws when nothing was solved yet, or
     /// with the quantization error (a free boundary, say).
     pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
-        let grid = self.grid.as_mut().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
+        self.valid_mesh()?;
+        let (Some(input), Some(grid)) = (self.mesh.as_ref(), self.grid.as_mut()) else {
+            return Err(JsError::new("solve the map before asking for quads").into());
+        };
+        if let Some(refine) = pipeline::quads_refine(input, &grid.options.refine) {
+            let options = SolveOptions { refine, ..grid.options };
+            let sol = pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)).map_err(|e| solve_error(&e))?;
+            *grid = GridStage { solution: sol.into_owned(), quantizer: None, features: grid.features.clone(), options };
+        }
         if grid.quantizer.is_none() {
             grid.quantizer = Some(grid.solution.quantizer().map_err(|e| JsError::new(&e.to_string()))?);
         }
@@ -345,6 +352,9 @@ impl MeshSession {
             edges: Uint32Array::from(&edges[..]),
             singular: Uint32Array::from(&singular[..]),
             defects: quad_mesh.defects.len(),
+            solved_faces: sol.mesh.n_faces(),
+            inserted_vertices: sol.splits,
+            refinement: &sol.refinement,
             obj: Uint8Array::from(obj.as_bytes()),
             glb: Uint8Array::from(&export::quads::write_quad_glb(&quad_mesh)[..]),
             grid_glb: Uint8Array::from(&grid_glb[..]),
@@ -465,6 +475,20 @@ fn notify(progress: &Function, stage: &str, a: usize, b: usize, fraction: Option
     };
 }
 
+/// Forwards the progress of both stages to the page's `progress`.
+fn solve_progress(progress: &Function) -> impl FnMut(SolveProgress) + '_ {
+    move |p| {
+        let (stage, a, b, fraction) = match p {
+            SolveProgress::Cones(c) => cone_stage(&c),
+            SolveProgress::Param(p) => {
+                let (stage, a, b) = param_stage(&p);
+                (stage, a, b, None)
+            }
+        };
+        notify(progress, stage, a, b, fraction);
+    }
+}
+
 /// Forwards cone-placement progress to the page's `progress`.
 fn cone_progress(progress: &Function) -> impl FnMut(ConeProgress) + '_ {
     move |p| {
@@ -567,6 +591,11 @@ struct QuadsResult<'a> {
     singular: Uint32Array,
     /// Places the extractor had to repair.
     defects: usize,
+    /// The mesh the map was solved on: its faces, the vertices inserted into
+    /// the input, and why ([`pipeline::quads_refine`] may have refined it).
+    solved_faces: usize,
+    inserted_vertices: usize,
+    refinement: &'a RefineCounts,
     /// The quad mesh as OBJ (UTF-8) and binary glTF.
     #[serde(with = "serde_wasm_bindgen::preserve")]
     obj: Uint8Array,

@@ -82,3 +82,40 @@ test('quads returns exactly the fields of QuadsResult: a valid quad mesh, grid U
   for (const l of faceLines) assert.equal(l.trim().split(/\s+/).length, 5, `not a quad: ${l}`);
   for (const glb of [r.glb, r.grid_glb]) assert.equal(new TextDecoder().decode(glb.subarray(0, 4)), 'glTF');
 });
+
+/** A cylinder as a CAD kernel exports it: radius 1, height 2, `n` segments, one band of long triangles, fan caps. */
+function cadCylinderObj(n) {
+  const lines = [];
+  for (const z of [0, 2]) {
+    for (let i = 0; i < n; i++) lines.push(`v ${Math.cos((2 * Math.PI * i) / n)} ${Math.sin((2 * Math.PI * i) / n)} ${z}`);
+  }
+  for (let i = 0; i < n; i++) {
+    const [a, b, c, d] = [i, (i + 1) % n, n + ((i + 1) % n), n + i].map((v) => v + 1);
+    lines.push(`f ${a} ${b} ${c}`, `f ${a} ${c} ${d}`);
+  }
+  for (let i = 1; i < n - 1; i++) lines.push(`f 1 ${i + 2} ${i + 1}`, `f ${n + 1} ${n + i + 1} ${n + i + 2}`);
+  return new TextEncoder().encode(lines.join('\n') + '\n');
+}
+
+test('quads of a low-poly mesh are traced on a map solved again on its refinement, once', () => {
+  const session = wasm.MeshSession.open([{ name: 'cylinder.obj', bytes: cadCylinderObj(24) }]);
+  const faces = session.indices().length / 3;
+  assert.equal(faces, 4 * 24 - 4);
+  const solved = session.solve(session.sharp_edges(60), undefined, false, () => {});
+  assert.equal(solved.refinement.long_edges, 0, 'the UV map keeps the input triangles');
+  const stages = new Set();
+  const r = session.quads(1000, (stage) => stages.add(stage));
+  assert.ok(stages.has('rounding') && stages.has('quantization'), [...stages].join(', '));
+  assert.ok(r.refinement.long_edges > 0 && r.inserted_vertices > 0, JSON.stringify(r.refinement));
+  assert.ok(r.solved_faces > 10 * faces, `${r.solved_faces} faces`);
+  assert.equal(r.uv.length, 6 * faces, 'grid UVs still on the input corners');
+  assert.equal(r.defects, 0);
+  assert.equal(r.report.euler_characteristic, 2);
+  assert.equal(r.report.flipped_quads, 0);
+  assert.ok(r.report.angle_mean_deviation < 8, `${r.report.angle_mean_deviation}°`);
+  assert.ok(r.report.singular_vertices.every((v) => v.valence === 3 || v.valence === 5), 'valences 3 and 5 only');
+  const again = new Set();
+  const r2 = session.quads(600, (stage) => again.add(stage));
+  assert.deepEqual([...again], ['quantization', 'quad extraction'], 'another count re-runs only quantization and extraction');
+  assert.equal(r2.solved_faces, r.solved_faces);
+});

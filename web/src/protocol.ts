@@ -149,6 +149,8 @@ export interface RefineCounts {
   enclosed_regions: number;
   zero_angle_faces: number;
   flipped_edges: number;
+  long_edges: number;
+  coplanar_flips: number;
 }
 
 /** How the requested feature edges came out (crate `pipeline::FeatureAlignment`). */
@@ -312,6 +314,10 @@ export interface QuadsResult {
   singular: Uint32Array;
   /** Places the extractor repaired (0 on a valid map). */
   defects: number;
+  /** The mesh the map was solved on: its faces and the vertices inserted into the input (a low-poly mesh is refined for quads). */
+  solved_faces: number;
+  inserted_vertices: number;
+  refinement: RefineCounts;
   /** The quad mesh as OBJ (UTF-8) and as binary glTF; the input mesh with the grid UVs as binary glTF. */
   obj: Uint8Array;
   glb: Uint8Array;
@@ -334,7 +340,7 @@ export const QUAD_REPORT_KEYS = {
 } as const satisfies Keys<QuadReport>;
 export const QUADS_RESULT_KEYS = {
   quantization: true, report: true, uv: true, positions: true, quads: true, edges: true, singular: true, defects: true,
-  obj: true, glb: true, grid_glb: true,
+  solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
 } as const satisfies Keys<QuadsResult>;
 
 /** A solve as the page receives it: the wasm result and what the worker adds. */

@@ -296,6 +296,9 @@ function quadTable(s: Shown, counts: ReturnType<typeof valenceCounts>): HTMLDLis
   if (r.distance_quads_to_input_relative !== undefined) {
     rows.push(['Distance to input (of bbox diagonal)', `${fmt(r.distance_quads_to_input_relative * 100, 2)} %`]);
   }
+  if (s.result.refinement.long_edges > 0) {
+    rows.push(['Solved on', `${fmtInt(s.result.solved_faces)} triangles (long edges split for quads)`]);
+  }
   rows.push(
     ['Defects (repaired)', fmtInt(s.result.defects)],
     ['Time: quantization', fmtMs(q.seconds * 1000)],
@@ -318,6 +321,8 @@ function quadsHook(s: Shown, counts: ReturnType<typeof valenceCounts>, gridCheck
     distortionBefore: r.quantization.distortion_before,
     distortionAfter: r.quantization.distortion_after,
     defects: r.defects,
+    solvedFaces: r.solved_faces,
+    insertedVertices: r.inserted_vertices,
     uvCorners: r.uv.length / 2,
     gridChecker,
     uvBounds: uvBounds(r.uv),

@@ -58,6 +58,9 @@ export interface QuadsHook {
   distortionBefore: number;
   distortionAfter: number;
   defects: number;
+  /** Faces of the mesh the map was solved on, and the vertices inserted into the input for it. */
+  solvedFaces: number;
+  insertedVertices: number;
   /** Face corners the grid UVs cover (2 numbers each). */
   uvCorners: number;
   /** The 3D checker is drawn from the grid UVs. */

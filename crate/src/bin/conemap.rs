@@ -46,7 +46,8 @@ commands:
 
   cones FILE [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
-             [--boundary aligned|free] [--max-cone-index K] [--no-moves] [--json]
+             [--boundary aligned|free] [--max-cone-index K] [--max-edge L|X%|none]
+             [--no-moves] [--json]
                        place cones (Myles & Zorin 2013, sections 4-5).
                        --alpha: alpha_smooth, 1e-4..1e3 (default 0.01; 100
                        with --miq). --miq: MIQ emulation (no harmonic
@@ -66,9 +67,14 @@ commands:
                        an interior cone, 1..3 (default 1: every cone has
                        quad valence 4 - k >= 3; 2 or 3 allow the fewer,
                        sharper cones a UV map may prefer, e.g. one of
-                       index 3 on a horn tip). --no-moves: skip the
-                       cone-location optimization. --json prints one JSON
-                       object.
+                       index 3 on a horn tip). --max-edge: first split
+                       edges longer than L model units (X% of the bounding-
+                       box diagonal), flipping edges between coplanar
+                       triangles to keep them well shaped: more vertices
+                       for the cones and the map on a low-poly mesh (a CAD
+                       export); default none (quads: 5%). --no-moves: skip
+                       the cone-location optimization. --json prints one
+                       JSON object.
                        On a terminal, the stage and its progress (rounding
                        round and integers left, cone-move pass, ARAP and
                        injective iterations) show on standard error while
@@ -103,7 +109,9 @@ commands:
                        as two triangles plus the quad edges as LINES.
                        --report: quads, singular vertices by valence,
                        corner-angle statistics, distortion before and after
-                       quantization, defects and per-stage timings.
+                       quantization, defects and per-stage timings. The
+                       map is solved on the input refined to --max-edge 5%
+                       (the quads lie on the input surface all the same).
 
 options:
   -h, --help           print this help
@@ -116,7 +124,7 @@ const COMMANDS: &[(&str, &[&str])] = &[
     ("info", &["--json"]),
     (
         "cones",
-        &["--json", "--quiet", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features=", "--boundary=", "--max-cone-index="],
+        &["--json", "--quiet", "--miq", "--no-moves", "--closed-features", "--alpha=", "--sharp=", "--min-feature-length=", "--features=", "--boundary=", "--max-cone-index=", "--max-edge="],
     ),
     (
         "solve",
@@ -132,6 +140,7 @@ const COMMANDS: &[(&str, &[&str])] = &[
             "--features=",
             "--boundary=",
             "--max-cone-index=",
+            "--max-edge=",
             "--report=",
             "--grid=",
             "--quads=",
@@ -152,6 +161,7 @@ const COMMANDS: &[(&str, &[&str])] = &[
             "--features=",
             "--boundary=",
             "--max-cone-index=",
+            "--max-edge=",
             "--report=",
             "--quad-size=",
             "--quads=",
@@ -392,6 +402,44 @@ fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
     Ok(features)
 }
 
+/// Both stages' settings: [`cone_options`] and `--max-edge L|X%` (split
+/// edges longer than L model units, or X % of `mesh`'s bounding-box
+/// diagonal, before the cones); `default_max_edge` when the flag is absent.
+fn solve_options(
+    args: &Args,
+    mesh: &TriMesh,
+    default_max_edge: Option<f64>,
+) -> Result<conemap::pipeline::SolveOptions, Failure> {
+    let mut options = conemap::pipeline::SolveOptions {
+        cones: cone_options(args)?,
+        ..Default::default()
+    };
+    options.refine.max_edge_length = match args.value("--max-edge") {
+        None => default_max_edge,
+        Some("none") => None,
+        Some(v) => {
+            let bad = || {
+                usage(&format!("--max-edge expects a positive length, a percentage (\"2%\") or none, got \"{v}\""))
+            };
+            let (number, fraction) = match v.strip_suffix('%') {
+                Some(p) => (p, true),
+                None => (v, false),
+            };
+            let x = number
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite() && *x > 0.0)
+                .ok_or_else(bad)?;
+            Some(if fraction {
+                x / 100.0 * mesh.bounding_diagonal()
+            } else {
+                x
+            })
+        }
+    };
+    Ok(options)
+}
+
 fn cone_options(args: &Args) -> Result<ConeOptions, Failure> {
     let miq = args.flag("--miq");
     let default_alpha = if miq { cones::MIQ_ALPHA } else { cones::DEFAULT_ALPHA };
@@ -482,8 +530,8 @@ fn cones_command(args: &Args) -> Result<(), Failure> {
     let file = args.file()?;
     let mesh = load_mesh(file)?;
     let features = load_features(args, &mesh)?;
-    let options = cone_options(args)?;
-    let solve_options = conemap::pipeline::SolveOptions { cones: options, ..Default::default() };
+    let solve_options = solve_options(args, &mesh, None)?;
+    let options = solve_options.cones;
     let bar = ProgressLine::new(args);
     let placed = conemap::pipeline::place_cones(&mesh, &features, &solve_options, &mut |p| bar.cones(&p));
     bar.finish();
@@ -508,8 +556,8 @@ fn cones_command(args: &Args) -> Result<(), Failure> {
 fn refinement_note(splits: usize, r: &conemap::features::RefineCounts) -> String {
     format!(
         "inserted {splits} vertices ({} lone feature edges opened, {} triangles with three and {} with two constrained edges split, \
-         {} enclosed regions given an interior vertex, {} faces split around cones of angle 0, {} long edges of flipped triangles split)",
-        r.lone_edges, r.triply_constrained, r.doubly_constrained, r.enclosed_regions, r.zero_angle_faces, r.flipped_edges
+         {} enclosed regions given an interior vertex, {} faces split around cones of angle 0, {} long edges of flipped triangles split, {} edges over the maximum length split)",
+        r.lone_edges, r.triply_constrained, r.doubly_constrained, r.enclosed_regions, r.zero_angle_faces, r.flipped_edges, r.long_edges
     )
 }
 
@@ -569,7 +617,7 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     let Some(format) = Format::from_path(out) else {
         return Err(usage(&format!("{out}: unknown output format (use .glb, .gltf or .obj)")));
     };
-    let options = cone_options(args)?;
+    cone_options(args)?;
     let grid = grid_option(args, "--grid")?;
     // Fail before the long computation when the output cannot be created.
     check_writable([Some(out), args.value("--report")].into_iter().flatten())?;
@@ -578,7 +626,8 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     let input_file = read_input(file)?;
     let mut times = SolveTimes { import: clock.lap(), ..SolveTimes::default() };
     let features = load_features(args, &input_file.mesh)?;
-    let solution = solve_mesh(args, file, &input_file.mesh, &features, options)?;
+    let options = solve_options(args, &input_file.mesh, None)?;
+    let solution = solve_mesh(args, file, &input_file.mesh, &features, &options)?;
     let alignment = solution.feature_alignment(&input_file.mesh, &features);
     times.cones = solution.refine_seconds + solution.placement.timings.total;
     times.param = clock.lap() - times.cones;
@@ -615,7 +664,7 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
 
     let written = Written { path: out, format, input: &input, options: &export_options, bytes: data.len() };
     if let Some(path) = args.value("--report") {
-        let mut report = solve_report(&solution, &options, &alignment, &written, &times);
+        let mut report = solve_report(&solution, &options.cones, &alignment, &written, &times);
         if let Some(g) = &grid_map {
             report["quantization"] = serde_json::json!(g.report);
         }
@@ -631,11 +680,16 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
 
 /// Places cones and parametrizes `mesh` (read from `file`) with the cone
 /// options of `args`, showing progress on a terminal.
-fn solve_mesh<'a>(args: &Args, file: &str, mesh: &'a TriMesh, features: &'a FeatureSet, options: ConeOptions) -> Result<conemap::pipeline::Solution<'a>, Failure> {
-    use conemap::pipeline::{self, SolveOptions};
-    let solve_options = SolveOptions { cones: options, ..SolveOptions::default() };
+fn solve_mesh<'a>(
+    args: &Args,
+    file: &str,
+    mesh: &'a TriMesh,
+    features: &'a FeatureSet,
+    options: &conemap::pipeline::SolveOptions,
+) -> Result<conemap::pipeline::Solution<'a>, Failure> {
+    use conemap::pipeline;
     let bar = ProgressLine::new(args);
-    let solution = pipeline::solve(mesh, features, &solve_options, &mut |p| match p {
+    let solution = pipeline::solve(mesh, features, options, &mut |p| match p {
         pipeline::SolveProgress::Cones(p) => bar.cones(&p),
         pipeline::SolveProgress::Param(p) => bar.param(&p),
     });

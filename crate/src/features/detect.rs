@@ -80,9 +80,9 @@ pub fn detect_sharp(mesh: &TriMesh, options: &SharpOptions) -> SharpDetection {
         stats.pruned_edges = prune_dangling(mesh, &mut features);
     }
     let curves = curves(mesh, &features);
-    let diagonal = bounding_diagonal(mesh);
+    let diagonal = mesh.bounding_diagonal();
     for curve in &curves {
-        let length: f64 = curve.iter().map(|&e| edge_length(mesh, e)).sum();
+        let length: f64 = curve.iter().map(|&e| mesh.edge_length(e)).sum();
         let short = match options.min_length {
             MinLength::None => false,
             MinLength::Edges(n) => curve.len() < n,
@@ -149,16 +149,6 @@ fn prune_dangling(mesh: &TriMesh, features: &mut FeatureSet) -> usize {
         }
     }
     removed
-}
-
-fn edge_length(mesh: &TriMesh, e: u32) -> f64 {
-    let [a, b] = mesh.edge_vertices(e).map(|v| mesh.position(v));
-    crate::vec3::norm(crate::vec3::sub(a, b))
-}
-
-fn bounding_diagonal(mesh: &TriMesh) -> f64 {
-    let (lo, hi) = crate::vec3::bounds(mesh.positions());
-    crate::vec3::norm(crate::vec3::sub(hi, lo))
 }
 
 #[cfg(test)]

@@ -8,13 +8,17 @@
 //! inserts the vertices some configurations need before an aligned map exists.
 
 mod cut;
+mod delaunay;
 pub mod detect;
 mod locate;
 mod refine;
 
 pub use cut::{boundary_turning, cut_open, CutMesh};
 pub use detect::{detect_sharp, MinLength, SharpDetection, SharpOptions, SharpStats};
-pub use refine::{refine_for_features, split_around, split_flipped, RefineCounts, Refined};
+pub use refine::{
+    refine_for_features, refine_for_features_on, split_around, split_flipped, split_long_edges,
+    RefineCounts, Refined,
+};
 
 use crate::mesh::TriMesh;
 use locate::VertexLocator;

@@ -18,10 +18,16 @@
 //! * a vertex that would need a cone of angle 0 ([`split_around`], on
 //!   request of the cone stage): the faces around it are split at their centroids.
 //!
+//! Two refinements serve the map rather than the features: triangles a map
+//! left flipped ([`split_flipped`]), and edges longer than a length
+//! ([`split_long_edges`]: a low-poly mesh has too few vertices for a map
+//! fine enough to trace quads on).
+//!
 //! Feature edges are only ever split along themselves, so the refined
 //! features are exactly the pieces of the input features.
 
 use super::cut::{boundary_turning, cut_open};
+use super::delaunay::flip_coplanar;
 use super::FeatureSet;
 use crate::mesh::{TriMesh, NONE};
 use serde::Serialize;
@@ -42,6 +48,10 @@ pub struct RefineCounts {
     pub zero_angle_faces: usize,
     /// Longest edges of triangles a map left flipped, split at their midpoint.
     pub flipped_edges: usize,
+    /// Edges longer than the asked maximum, split at their midpoint ([`split_long_edges`]).
+    pub long_edges: usize,
+    /// Edges between coplanar triangles flipped to make them Delaunay ([`split_long_edges`]).
+    pub coplanar_flips: usize,
 }
 
 impl RefineCounts {
@@ -52,6 +62,8 @@ impl RefineCounts {
         self.enclosed_regions += o.enclosed_regions;
         self.zero_angle_faces += o.zero_angle_faces;
         self.flipped_edges += o.flipped_edges;
+        self.long_edges += o.long_edges;
+        self.coplanar_flips += o.coplanar_flips;
     }
 }
 
@@ -79,7 +91,16 @@ const MAX_PASSES: usize = 16;
 /// Refines `mesh` until none of the configurations of the module doc is
 /// left (or [`MAX_PASSES`] passes ran). Returns `None` when nothing needs it.
 pub fn refine_for_features(mesh: &TriMesh, features: &FeatureSet) -> Option<Refined> {
-    let mut current: Option<Refined> = None;
+    refine_for_features_on(mesh, features, None)
+}
+
+/// [`refine_for_features`] on top of the refinement `current` of `mesh`
+/// (`None`: the input itself); `current` when nothing more needs it.
+pub fn refine_for_features_on(
+    mesh: &TriMesh,
+    features: &FeatureSet,
+    mut current: Option<Refined>,
+) -> Option<Refined> {
     for _ in 0..MAX_PASSES {
         let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
         let mut plan = Splits::new(m);
@@ -120,21 +141,68 @@ pub fn split_around(mesh: &TriMesh, features: &FeatureSet, current: Option<Refin
 pub fn split_flipped(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>, faces: &[u32]) -> Refined {
     let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
     let mut plan = Splits::new(m);
+    let lengths = edge_lengths(m);
     for &face in faces {
-        let longest = m.face_halfedges(face).into_iter().map(|h| m.edge(h)).max_by(|&a, &b| {
-            let length = |e: u32| {
-                let [u, w] = m.edge_vertices(e);
-                crate::vec3::norm(crate::vec3::sub(m.position(u), m.position(w)))
-            };
-            length(a).total_cmp(&length(b))
-        });
-        if let Some(e) = longest {
-            if plan.edge(m, e) {
-                plan.counts.flipped_edges += 1;
-            }
+        if plan.edge(m, longest_edge(m, &lengths, face)) {
+            plan.counts.flipped_edges += 1;
         }
     }
     plan.apply(m, f, current.as_ref())
+}
+
+/// Passes of [`split_long_edges`]: each halves the longest edge of every
+/// face it may; 48 passes take an edge down by far more than any mesh
+/// needs (a face may wait for a neighbour's split).
+const MAX_LENGTH_PASSES: usize = 48;
+
+/// Splits edges of `mesh` (on top of its refinement `current`, if any)
+/// longer than `max_length` at their midpoints, longest first, until none
+/// is left; between passes, edges between coplanar triangles are flipped to
+/// make them Delaunay ([`flip_coplanar`]), so that a flat region's long thin
+/// triangles give well-shaped small ones instead of thinner strips. The
+/// surface, its features and its boundary are unchanged. `current` when no
+/// edge is that long.
+pub fn split_long_edges(mesh: &TriMesh, features: &FeatureSet, mut current: Option<Refined>, max_length: f64) -> Option<Refined> {
+    if long_edges(current.as_ref().map_or(mesh, |r| &r.mesh), max_length).is_empty() {
+        return current;
+    }
+    current = flip_coplanar(mesh, features, current);
+    for _ in 0..MAX_LENGTH_PASSES {
+        let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
+        let long = long_edges(m, max_length);
+        if long.is_empty() {
+            break;
+        }
+        let mut plan = Splits::new(m);
+        for e in long {
+            if plan.edge(m, e) {
+                plan.counts.long_edges += 1;
+            }
+        }
+        current = flip_coplanar(mesh, features, Some(plan.apply(m, f, current.as_ref())));
+    }
+    current
+}
+
+/// The longest edge of every face of `m` that is longer than `max_length`, longest first.
+fn long_edges(m: &TriMesh, max_length: f64) -> Vec<u32> {
+    let lengths = edge_lengths(m);
+    let mut long: Vec<u32> =
+        (0..m.n_faces() as u32).map(|face| longest_edge(m, &lengths, face)).filter(|&e| lengths[e as usize] > max_length).collect();
+    long.sort_unstable_by(|&a, &b| lengths[b as usize].total_cmp(&lengths[a as usize]).then(a.cmp(&b)));
+    long.dedup();
+    long
+}
+
+/// The length of every edge of `m`.
+fn edge_lengths(m: &TriMesh) -> Vec<f64> {
+    (0..m.n_edges() as u32).map(|e| m.edge_length(e)).collect()
+}
+
+/// The longest edge of `face` by `lengths` (the last of its halfedges' among equals).
+fn longest_edge(m: &TriMesh, lengths: &[f64], face: u32) -> u32 {
+    let edges = m.face_halfedges(face).map(|h| m.edge(h));
+    edges.into_iter().max_by(|&a, &b| lengths[a as usize].total_cmp(&lengths[b as usize])).expect("a face has three edges")
 }
 
 /// True when edge `e` of `m` is a feature or boundary edge.
@@ -405,5 +473,42 @@ mod tests {
                 .any(|v| !cut.mesh.is_boundary_vertex(v) && cut.mesh.vertex_component(v) == c);
             assert!(interior || sum == 4 * cut.mesh.component_euler_characteristic(c), "component {c}: corners sum to {sum}");
         }
+    }
+
+    /// A CAD cylinder (bands of long triangles, caps of slivers) split to a
+    /// length: every edge is that short after, the rims are the same curves
+    /// in pieces, every vertex lies on the input surface, and splits and
+    /// flips are counted.
+    #[test]
+    fn long_edges_are_split_down_to_the_length_on_the_surface() {
+        let m = TriMesh::from_raw(&crate::mesh::shapes::cad_cylinder(16, 3.0)).unwrap();
+        let f = FeatureSet::sharp_edges(&m, 60.0);
+        let length = 0.3;
+        let r = split_long_edges(&m, &f, None, length).expect("the cylinder has long edges");
+        assert!((0..r.mesh.n_edges() as u32).all(|e| r.mesh.edge_length(e) <= length));
+        assert!(
+            r.counts.long_edges > 0 && r.counts.coplanar_flips > 0,
+            "{:?}",
+            r.counts
+        );
+        assert_eq!(r.splits, r.mesh.n_vertices() - m.n_vertices());
+        assert_eq!(r.mesh.euler_characteristic(), m.euler_characteristic());
+        let total = |m: &TriMesh, f: &FeatureSet| f.edges().map(|e| m.edge_length(e)).sum::<f64>();
+        assert!((total(&r.mesh, &r.features) - total(&m, &f)).abs() < 1e-9);
+        let area = |m: &TriMesh| m.face_areas().iter().sum::<f64>();
+        assert!((area(&r.mesh) - area(&m)).abs() < 1e-9 * area(&m));
+        for v in 0..r.mesh.n_vertices() as u32 {
+            let p = r.mesh.position(v);
+            let on = (0..m.n_faces() as u32).any(|g| {
+                let t = m.faces()[g as usize].map(|x| m.position(x));
+                let q = crate::vec3::barycentric_point(
+                    &t,
+                    crate::vec3::closest_point_barycentric(p, &t),
+                );
+                crate::vec3::norm(crate::vec3::sub(p, q)) < 1e-12
+            });
+            assert!(on, "vertex {v} is off the input");
+        }
+        assert!(split_long_edges(&r.mesh, &r.features, None, length).is_none());
     }
 }

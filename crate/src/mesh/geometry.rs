@@ -154,6 +154,21 @@ impl TriMesh {
         self.geometry.face_frames.get_or_init(|| FaceFrames::new(self))
     }
 
+    /// Length of edge `e`.
+    pub fn edge_length(&self, e: u32) -> f64 {
+        let [a, b] = self.edge_vertices(e);
+        norm(sub(self.position(a), self.position(b)))
+    }
+
+    /// Length of the diagonal of the axis-aligned bounding box (0 for an empty mesh).
+    pub fn bounding_diagonal(&self) -> f64 {
+        if self.n_vertices() == 0 {
+            return 0.0;
+        }
+        let (lo, hi) = crate::vec3::bounds(self.positions());
+        norm(sub(hi, lo))
+    }
+
     /// Angle of halfedge `h`'s direction in the frame of face `h / 3`
     /// (`h` a face halfedge).
     #[inline]

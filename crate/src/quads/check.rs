@@ -162,14 +162,7 @@ pub fn check_quads(input: &TriMesh, quads: &QuadMesh, options: &CheckOptions) ->
     let edges = quad_edges(quads);
     let fans = vertex_fans(quads, &valid, &edges);
     let angles = corner_angles(quads, &valid);
-    let diagonal = {
-        let (lo, hi) = bounds(input.positions());
-        if input.n_vertices() > 0 {
-            norm(sub(hi, lo))
-        } else {
-            0.0
-        }
-    };
+    let diagonal = input.bounding_diagonal();
     let relative = |d: Option<f64>| d.filter(|_| diagonal > 0.0).map(|d| d / diagonal);
 
     let mut report = QuadReport {

@@ -2,7 +2,7 @@
 //! and the quad mesh traced on it, written as OBJ (quads) or glTF (each quad
 //! as two triangles plus a LINES primitive of the quad edges).
 
-use super::{check_writable, cone_options, grid_option, load_features, quantize, read_input, solve_mesh, usage, Args, Failure};
+use super::{check_writable, cone_options, grid_option, load_features, quantize, read_input, solve_mesh, solve_options, usage, Args, Failure};
 use conemap::param::quantize::GridSize;
 use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions, QuadReport};
 use std::path::Path;
@@ -19,7 +19,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     if !obj && !lower.ends_with(".glb") {
         return Err(usage(&format!("{out}: unknown quad-mesh format (use .obj or .glb)")));
     }
-    let options = cone_options(args)?;
+    cone_options(args)?;
     let grid = grid_option(args, "--quad-size")?.unwrap_or(GridSize::Quads(DEFAULT_QUADS));
     check_writable([Some(out), args.value("--report")].into_iter().flatten())?;
 
@@ -27,7 +27,9 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let input = read_input(file)?;
     let import = clock.lap();
     let features = load_features(args, &input.mesh)?;
-    let solution = solve_mesh(args, file, &input.mesh, &features, options)?;
+    let max_edge = conemap::pipeline::RefineOptions::for_quads(&input.mesh).max_edge_length;
+    let options = solve_options(args, &input.mesh, max_edge)?;
+    let solution = solve_mesh(args, file, &input.mesh, &features, &options)?;
     let solve = clock.lap();
     let map = quantize(file, &solution, grid)?;
     let quantize_seconds = clock.lap();
