@@ -7,7 +7,7 @@ use crate::cones::{self, BoundaryMode, ComponentFigures, ComponentPlacement, Con
 use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::quantize::{GridSize, QuantizeReport, Quantizer};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
-use crate::quads::{self, check_quads, extract_quads, CheckOptions, ExtractOptions, QuadReport};
+use crate::quads::{self, check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
 use crate::pipeline::{self, ConeStage, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
 use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
@@ -332,7 +332,7 @@ impl MeshSession {
             .quantize(&sol.mesh, GridSize::Quads(quads as usize), &mut |done, total| notify(progress, "quantization", done, total, None))
             .map_err(|e| JsError::new(&e.to_string()))?;
         notify(progress, "quad extraction", 0, 0, None);
-        let quad_mesh = extract_quads(&sol.mesh, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
+        let quad_mesh = extract_quads_along(&sol.mesh, &sol.features, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
         let sharp: Vec<u32> = sol.features.edges().collect();
         let report = check_quads(&sol.mesh, &quad_mesh, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
         let uv: Vec<f32> = sol.input_corner_values(input, &map.uv).iter().flat_map(|p| p.map(|c| c as f32)).collect();

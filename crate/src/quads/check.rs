@@ -383,7 +383,7 @@ fn quad_points(quads: &QuadMesh, q: usize) -> [V3; 4] {
 }
 
 /// Newell normal of a polygon: its length is twice the (projected) area.
-fn newell_normal(p: &[V3; 4]) -> V3 {
+pub(crate) fn newell_normal(p: &[V3; 4]) -> V3 {
     (0..4).fold([0.0; 3], |n, i| add(n, cross(p[i], p[(i + 1) % 4])))
 }
 

@@ -11,12 +11,15 @@
 //! 5. `close_polygons`: a cycle of more sides (the map winds twice around a
 //!    point in the cell) is closed with quads around an input vertex there;
 //! 6. `fill::fill_holes`: the holes left where cells were skipped (flipped
-//!    triangles) are filled with quads on the input surface.
+//!    triangles) are filled with quads on the input surface;
+//! 7. `corners::align_curve_corners`: quad vertices slid along feature and
+//!    boundary polylines onto the corners quad edges would cut.
 //!
 //! Every predicate after step 1 is exact integer arithmetic. Where the map is
 //! not a valid integer-grid map the extractor closes or skips what it cannot
 //! trace as a quad and records a [`QuadDefect`].
 
+mod corners;
 mod faces;
 mod fill;
 mod snap;
@@ -28,6 +31,7 @@ mod vertices;
 mod extract_tests;
 
 use super::{QuadDefect, QuadMesh, SurfacePoint};
+use crate::features::FeatureSet;
 use crate::mesh::NONE;
 use crate::TriMesh;
 use snap::{dot, orient, sub};
@@ -101,6 +105,13 @@ impl std::error::Error for ExtractError {}
 /// these are listed in [`QuadMesh::defects`]. Errs only on a wrong number of UVs or a UV that is
 /// not finite or beyond [`MAX_UV`]; never panics.
 pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) -> Result<QuadMesh, ExtractError> {
+    extract_quads_along(mesh, &FeatureSet::none(mesh), uv, options)
+}
+
+/// [`extract_quads`] on a map whose isolines follow the feature edges
+/// `features` of `mesh`: their polylines' corners (and the boundary's) get
+/// quad vertices where quad edges would cut them (step 7).
+pub fn extract_quads_along(mesh: &TriMesh, features: &FeatureSet, uv: &[[f64; 2]], options: &ExtractOptions) -> Result<QuadMesh, ExtractError> {
     let expected = 3 * mesh.n_faces();
     if uv.len() != expected {
         return Err(ExtractError::CornerCount { expected, found: uv.len() });
@@ -146,6 +157,7 @@ pub fn extract_quads(mesh: &TriMesh, uv: &[[f64; 2]], options: &ExtractOptions) 
     close_polygons(mesh, &cells.polygons, &mut quads);
     fill::fill_holes(mesh, &mut quads);
     drop_unreferenced(&mut quads);
+    corners::align_curve_corners(mesh, features, &mut quads);
     Ok(quads)
 }
 

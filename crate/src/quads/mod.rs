@@ -15,7 +15,7 @@ pub mod check;
 pub mod extract;
 
 pub use check::{check_quads, CheckOptions, QuadReport};
-pub use extract::{exact_grid_uv, extract_quads, ExtractError, ExtractOptions};
+pub use extract::{exact_grid_uv, extract_quads, extract_quads_along, ExtractError, ExtractOptions};
 
 use serde::Serialize;
 

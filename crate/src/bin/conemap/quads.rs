@@ -4,7 +4,7 @@
 
 use super::{check_writable, cone_options, grid_option, load_features, quantize, read_input, solve_mesh, solve_options, usage, Args, Failure};
 use conemap::param::quantize::GridSize;
-use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions, QuadReport};
+use conemap::quads::{check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
 use std::path::Path;
 
 /// Quads asked for when neither `--quad-size` nor `--quads` is given.
@@ -33,7 +33,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let solve = clock.lap();
     let map = quantize(file, &solution, grid)?;
     let quantize_seconds = clock.lap();
-    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let extract = clock.lap();
     let sharp: Vec<u32> = solution.features.edges().collect();
     let report = check_quads(&solution.mesh, &quads, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });

@@ -1,0 +1,165 @@
+//! Step 7 of extraction: quad vertices moved onto the corners of the
+//! input's feature and boundary polylines. A curved feature of a mesh (a
+//! cylinder's rim) is a polygon; the quad edges along it run between
+//! integer points on its segments, so a quad edge that spans a corner of the
+//! polygon cuts it, off the input's sharp edge by the corner's sagitta. Where
+//! that matters, the quad vertex on the curve nearest to the corner is slid
+//! along the curve onto it (quads stay on the surface and the curve stays a
+//! chain of quad edges; no quad may flip).
+
+use super::QuadMesh;
+use crate::features::FeatureSet;
+use crate::mesh::TriMesh;
+use crate::quads::check::newell_normal;
+use crate::quads::SurfacePoint;
+use crate::vec3::{add, cross, dot, norm, segment_parameter, sub, V3};
+
+/// Corners closer than this (a fraction of the bounding-box diagonal) to the
+/// quad edge that spans them are left alone.
+const MIN_DEVIATION: f64 = 1e-4;
+
+/// A quad vertex inside a curve edge of the input.
+#[derive(Clone, Copy, Debug)]
+struct OnEdge {
+    vertex: u32,
+    /// Arc length from the edge's first end (`edge_vertices(e)[0]`).
+    t: f64,
+}
+
+/// Moves quad vertices onto the corners of the feature (`features`) and
+/// boundary polylines of `mesh` that quad edges would otherwise cut (see
+/// the module doc); returns how many moved. A quad vertex at an input
+/// vertex is never moved; each moves at most once.
+pub(super) fn align_curve_corners(mesh: &TriMesh, features: &FeatureSet, quads: &mut QuadMesh) -> usize {
+    let curve = |e: u32| mesh.is_boundary_edge(e) || features.contains(e);
+    let diagonal = mesh.bounding_diagonal();
+    // Quad vertices at input vertices, and inside curve edges.
+    let mut at_vertex = vec![false; mesh.n_vertices()];
+    let mut on_edge: Vec<Vec<OnEdge>> = vec![Vec::new(); mesh.n_edges()];
+    for (v, loc) in quads.locations.iter().enumerate() {
+        let face = mesh.faces()[loc.face as usize];
+        let zeros: Vec<usize> = (0..3).filter(|&k| loc.bary[k].abs() <= 1e-12).collect();
+        match zeros[..] {
+            [a, b] => at_vertex[face[3 - a - b] as usize] = true,
+            [k] => {
+                let h = mesh.face_halfedges(loc.face)[(k + 1) % 3];
+                let e = mesh.edge(h);
+                if curve(e) {
+                    let [p, q] = mesh.edge_vertices(e).map(|x| mesh.position(x));
+                    let t = segment_parameter(quads.positions[v], p, q) * norm(sub(q, p));
+                    on_edge[e as usize].push(OnEdge { vertex: v as u32, t });
+                }
+            }
+            _ => {}
+        }
+    }
+    let incident = vertex_quads(quads);
+    // Corners of the polylines, sharpest first.
+    let mut corners: Vec<(f64, u32, [u32; 2])> = (0..mesh.n_vertices() as u32)
+        .filter(|&c| !at_vertex[c as usize])
+        .filter_map(|c| {
+            let edges: Vec<u32> = mesh.outgoing(c).map(|h| mesh.edge(h)).filter(|&e| curve(e)).collect();
+            let [a, b] = edges[..] else { return None };
+            let (pa, pb, pc) = (mesh.position(other_end(mesh, a, c)), mesh.position(other_end(mesh, b, c)), mesh.position(c));
+            let turning = std::f64::consts::PI - angle(sub(pa, pc), sub(pb, pc));
+            Some((turning, c, [a, b]))
+        })
+        .collect();
+    corners.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+    let mut moved = vec![false; quads.positions.len()];
+    let mut count = 0;
+    for (_, c, edges) in corners {
+        // Only a quad edge that spans this corner alone: one whose ends lie
+        // on the corner's own two edges (where it spans several, sliding one
+        // vertex onto one corner leaves the others cut and skews the quads).
+        let sides = edges.map(|e| nearest_on_edge(mesh, &on_edge, c, e));
+        let [Some((left, dl)), Some((right, dr))] = sides else { continue };
+        let target = mesh.position(c);
+        let chord = (quads.positions[left as usize], quads.positions[right as usize]);
+        let on_chord = segment_point(chord.0, chord.1, target);
+        if norm(sub(on_chord, target)) <= MIN_DEVIATION * diagonal {
+            continue;
+        }
+        let (v, _) = if dl <= dr { (left, dl) } else { (right, dr) };
+        if moved[v as usize] || !keeps_quads_valid(quads, &incident[v as usize], v, target) {
+            continue;
+        }
+        quads.positions[v as usize] = target;
+        quads.locations[v as usize] = vertex_location(mesh, c, quads.locations[v as usize]);
+        moved[v as usize] = true;
+        count += 1;
+    }
+    count
+}
+
+/// The other end of edge `e` than `v`.
+fn other_end(mesh: &TriMesh, e: u32, v: u32) -> u32 {
+    let [a, b] = mesh.edge_vertices(e);
+    if a == v { b } else { a }
+}
+
+/// Angle between `u` and `w`.
+fn angle(u: V3, w: V3) -> f64 {
+    norm(cross(u, w)).atan2(dot(u, w))
+}
+
+/// The point of segment `[a, b]` nearest `p`.
+fn segment_point(a: V3, b: V3, p: V3) -> V3 {
+    let t = segment_parameter(p, a, b);
+    add(a, crate::vec3::scale(sub(b, a), t))
+}
+
+/// The quad vertex inside curve edge `e` nearest to its end `c`, and its
+/// distance from `c`.
+fn nearest_on_edge(mesh: &TriMesh, on_edge: &[Vec<OnEdge>], c: u32, e: u32) -> Option<(u32, f64)> {
+    let [a, _] = mesh.edge_vertices(e);
+    let length = mesh.edge_length(e);
+    on_edge[e as usize]
+        .iter()
+        .map(|o| (o.vertex, if a == c { o.t } else { length - o.t }))
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+}
+
+/// The quads around each quad vertex.
+fn vertex_quads(quads: &QuadMesh) -> Vec<Vec<u32>> {
+    let mut out = vec![Vec::new(); quads.positions.len()];
+    for (q, corners) in quads.quads.iter().enumerate() {
+        for &v in corners {
+            out[v as usize].push(q as u32);
+        }
+    }
+    out
+}
+
+/// True when moving quad vertex `v` to `to` leaves every quad of `around`
+/// turned as it was: each of its four corner triangles keeps a positive
+/// side against the quad's normal before the move.
+fn keeps_quads_valid(quads: &QuadMesh, around: &[u32], v: u32, to: V3) -> bool {
+    around.iter().all(|&q| {
+        let corners = quads.quads[q as usize];
+        let before = corners.map(|x| quads.positions[x as usize]);
+        let after = corners.map(|x| if x == v { to } else { quads.positions[x as usize] });
+        let normal = newell_normal(&before);
+        (0..4).all(|i| {
+            let (p, c, n) = (after[(i + 3) % 4], after[i], after[(i + 1) % 4]);
+            dot(cross(sub(n, c), sub(p, c)), normal) > 0.0
+        })
+    })
+}
+
+/// Input vertex `c` as a surface point: in the face of `near` when it has
+/// `c` as a corner, else in the face around `c` whose normal is closest to
+/// `near`'s face's.
+fn vertex_location(mesh: &TriMesh, c: u32, near: SurfacePoint) -> SurfacePoint {
+    let normals = mesh.face_normals();
+    let face = if mesh.faces()[near.face as usize].contains(&c) {
+        near.face
+    } else {
+        let n = normals[near.face as usize];
+        mesh.vertex_faces(c).max_by(|&a, &b| dot(normals[a as usize], n).total_cmp(&dot(normals[b as usize], n))).unwrap_or(near.face)
+    };
+    let mut bary = [0.0; 3];
+    let k = mesh.faces()[face as usize].iter().position(|&x| x == c).expect("the face has c as a corner");
+    bary[k] = 1.0;
+    SurfacePoint { face, bary }
+}
