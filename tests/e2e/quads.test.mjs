@@ -190,6 +190,36 @@ describe('quad mode', () => {
     assertGridLayout(h);
   });
 
+  it('traces the quads of a low-poly CAD cylinder on a map solved again on its refinement', async () => {
+    const n = 24;
+    const lines = [];
+    for (const z of [0, 2]) for (let i = 0; i < n; i++) lines.push(`v ${Math.cos((2 * Math.PI * i) / n)} ${Math.sin((2 * Math.PI * i) / n)} ${z}`);
+    for (let i = 1; i <= n; i++) {
+      const j = (i % n) + 1;
+      lines.push(`f ${i} ${j} ${n + j}`, `f ${i} ${n + j} ${n + i}`);
+    }
+    for (let i = 2; i < n; i++) lines.push(`f 1 ${i + 1} ${i}`, `f ${n + 1} ${n + i} ${n + i + 1}`);
+    const loads = (await hooks()).loads;
+    await page.getByTestId('file-input').setInputFiles({ name: 'cylinder.obj', mimeType: 'text/plain', buffer: Buffer.from(lines.join('\n') + '\n') });
+    await page.waitForFunction((k) => window.__conemap.loads > k && window.__conemap.state !== 'loading', loads, { timeout: LOAD_TIMEOUT });
+    await page.getByTestId('sharp-toggle').check();
+    await page.getByTestId('sharp-angle').fill('60');
+    await page.waitForFunction(() => window.__conemap.features === 48, null, { timeout: 10_000 });
+    let h = await hooks();
+    const { solves, quadRuns } = h;
+    await page.getByTestId('run').click();
+    await page.waitForFunction((k) => window.__conemap.solves > k, solves, { timeout: SOLVE_TIMEOUT });
+    await page.evaluate(() => window.__conemapTest.setQuadCount(1000));
+    await page.waitForFunction((k) => window.__conemap.quadRuns > k && window.__conemap.quads?.target === 1000
+      && document.body.dataset.quads !== 'running', quadRuns, { timeout: QUADS_TIMEOUT });
+    h = await hooks();
+    assert.ok(h.quads, h.quadsError ?? '');
+    assert.ok(h.quads.solvedFaces > 10 * (4 * n - 4), `solved on ${h.quads.solvedFaces} faces`);
+    assert.equal(h.quads.defects, 0);
+    assert.equal(h.quads.uvCorners, 3 * (4 * n - 4), 'grid UVs on the input corners');
+    assert.match(await page.getByTestId('quad-stats').innerText(), /Solved on\s+[\d,]+ triangles \(long edges split for quads\)/);
+  });
+
   it('logged no unexpected console errors', () => {
     assert.deepEqual(consoleErrors, []);
   });
