@@ -10,18 +10,24 @@ import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
+import { cadCylinderObj } from './cad-cylinder.mjs';
 
 /** Quads asked for (the CLI's `--quads N`, `MeshSession.quads(n)`). */
 export const QUAD_TARGETS = [1000, 3000, 10000];
 
 /**
  * The meshes: fandisk with its sharp edges (> 60°) as features, spot without
- * features (spot only where ../shared/meshes is present).
+ * features (spot only where ../shared/meshes is present), and a low-poly
+ * CAD cylinder (24 segments, 92 long triangles, rims > 60° as features),
+ * which the quad solve refines first (`pipeline::QUAD_MAX_EDGE`).
  */
 export function quadMeshes(fandisk, sharedMeshes) {
   const meshes = [{ name: 'fandisk.obj', file: fandisk, sharp: 60, label: 'fandisk.obj (sharp > 60°)' }];
   const spot = path.join(sharedMeshes, 'spot.obj');
   if (fs.existsSync(spot)) meshes.push({ name: 'spot.obj', file: spot, sharp: null, label: 'spot.obj (no features)' });
+  const cylinder = path.join(os.tmpdir(), 'conemap-bench-cad-cylinder.obj');
+  fs.writeFileSync(cylinder, cadCylinderObj(24));
+  meshes.push({ name: 'cad-cylinder.obj', file: cylinder, sharp: 60, label: 'CAD cylinder, 24 segments (sharp > 60°)' });
   return meshes;
 }
 

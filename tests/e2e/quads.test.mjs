@@ -7,6 +7,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { after, before, describe, it } from 'node:test';
 import validator from 'gltf-validator';
+import { cadCylinderObj } from '../../scripts/lib/cad-cylinder.mjs';
 import { closePage, openPage, output } from './harness.mjs';
 
 const LOAD_TIMEOUT = 90_000;
@@ -192,15 +193,8 @@ describe('quad mode', () => {
 
   it('traces the quads of a low-poly CAD cylinder on a map solved again on its refinement', async () => {
     const n = 24;
-    const lines = [];
-    for (const z of [0, 2]) for (let i = 0; i < n; i++) lines.push(`v ${Math.cos((2 * Math.PI * i) / n)} ${Math.sin((2 * Math.PI * i) / n)} ${z}`);
-    for (let i = 1; i <= n; i++) {
-      const j = (i % n) + 1;
-      lines.push(`f ${i} ${j} ${n + j}`, `f ${i} ${n + j} ${n + i}`);
-    }
-    for (let i = 2; i < n; i++) lines.push(`f 1 ${i + 1} ${i}`, `f ${n + 1} ${n + i} ${n + i + 1}`);
     const loads = (await hooks()).loads;
-    await page.getByTestId('file-input').setInputFiles({ name: 'cylinder.obj', mimeType: 'text/plain', buffer: Buffer.from(lines.join('\n') + '\n') });
+    await page.getByTestId('file-input').setInputFiles({ name: 'cylinder.obj', mimeType: 'text/plain', buffer: Buffer.from(cadCylinderObj(n)) });
     await page.waitForFunction((k) => window.__conemap.loads > k && window.__conemap.state !== 'loading', loads, { timeout: LOAD_TIMEOUT });
     await page.getByTestId('sharp-toggle').check();
     await page.getByTestId('sharp-angle').fill('60');

@@ -5,6 +5,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import { before, test } from 'node:test';
+import { cadCylinderObj } from '../../scripts/lib/cad-cylinder.mjs';
 import { committedFandisk, loadPageModule, loadWasm, sharedMesh } from './wasm.mjs';
 
 const wasm = loadWasm();
@@ -83,22 +84,8 @@ test('quads returns exactly the fields of QuadsResult: a valid quad mesh, grid U
   for (const glb of [r.glb, r.grid_glb]) assert.equal(new TextDecoder().decode(glb.subarray(0, 4)), 'glTF');
 });
 
-/** A cylinder as a CAD kernel exports it: radius 1, height 2, `n` segments, one band of long triangles, fan caps. */
-function cadCylinderObj(n) {
-  const lines = [];
-  for (const z of [0, 2]) {
-    for (let i = 0; i < n; i++) lines.push(`v ${Math.cos((2 * Math.PI * i) / n)} ${Math.sin((2 * Math.PI * i) / n)} ${z}`);
-  }
-  for (let i = 0; i < n; i++) {
-    const [a, b, c, d] = [i, (i + 1) % n, n + ((i + 1) % n), n + i].map((v) => v + 1);
-    lines.push(`f ${a} ${b} ${c}`, `f ${a} ${c} ${d}`);
-  }
-  for (let i = 1; i < n - 1; i++) lines.push(`f 1 ${i + 2} ${i + 1}`, `f ${n + 1} ${n + i + 1} ${n + i + 2}`);
-  return new TextEncoder().encode(lines.join('\n') + '\n');
-}
-
 test('quads of a low-poly mesh are traced on a map solved again on its refinement, once', () => {
-  const session = wasm.MeshSession.open([{ name: 'cylinder.obj', bytes: cadCylinderObj(24) }]);
+  const session = wasm.MeshSession.open([{ name: 'cylinder.obj', bytes: new TextEncoder().encode(cadCylinderObj(24)) }]);
   const faces = session.indices().length / 3;
   assert.equal(faces, 4 * 24 - 4);
   const solved = session.solve(session.sharp_edges(60), undefined, false, () => {});

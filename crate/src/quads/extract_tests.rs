@@ -841,3 +841,34 @@ fn holes_at_the_boundary_are_filled_along_it() {
     }
     assert_positive_areas(&q);
 }
+
+/// The quads of a cube with the band of quads around its middle (no quad
+/// vertex with z in (0.3, 0.7)) taken out fall into two pieces, each with
+/// one hole: filling both would give two closed surfaces; the holes are
+/// joined by a strip of quads instead, into one closed manifold sphere.
+#[test]
+fn holes_that_cut_the_quads_in_two_are_joined() {
+    let (pos, tris, uv) = cube(4, 1.0, false, 0.0);
+    let m = mesh(pos, tris);
+    let mut q = extract(&m, &uv);
+    assert!(q.defects.is_empty(), "{:?}", q.defects);
+    let n = q.n_quads();
+    let middle = |v: &u32| (0.3..0.7).contains(&q.positions[*v as usize][2]);
+    let band: Vec<usize> = (0..n).filter(|&i| q.quads[i].iter().any(middle)).collect();
+    assert_eq!(band.len(), 4 * 4 * 2, "two rows of quads around");
+    q.quads = q.quads.iter().enumerate().filter(|(i, _)| !band.contains(i)).map(|(_, c)| *c).collect();
+    q.uv = (0..q.quads.len()).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]).collect();
+    super::fill::fill_holes(&m, &mut q);
+    let joined: Vec<&QuadDefect> = q.defects.iter().filter(|d| d.what.contains("joined with 16 quads")).collect();
+    assert_eq!(joined.len(), 1, "{:?}", q.defects);
+    assert_eq!(q.n_quads(), n - 16);
+    let t = topology(&q);
+    assert!(t.manifold, "{t:?}");
+    assert_eq!((t.euler, t.boundary_loops), (2, 0), "{t:?}");
+    // The strip's quads run straight across the gap: each joins a vertex
+    // at z = 0.25 to the one at z = 0.75 above it.
+    for quad in &q.quads[n - 32..] {
+        let z: Vec<f64> = quad.iter().map(|&v| q.positions[v as usize][2]).collect();
+        assert!(z.iter().filter(|&&z| z == 0.25).count() == 2 && z.iter().filter(|&&z| z == 0.75).count() == 2, "{z:?}");
+    }
+}

@@ -7,11 +7,13 @@
 //! the quads that does not run along the input's boundary is such a hole;
 //! one with an even number of sides is filled with quads whose new vertices
 //! lie on the input surface, and recorded as a defect; one that reaches the
-//! input's boundary is closed with new vertices along it. Odd and overlong
-//! holes stay open (also recorded); a loop through a vertex twice is left
-//! as it is.
+//! input's boundary is closed with new vertices along it. Two holes that
+//! cut the quads into more pieces than the input has are joined by a strip
+//! of quads instead (`bridge`). Odd and overlong holes stay open (also
+//! recorded); a loop through a vertex twice is left as it is.
 
 mod boundary;
+mod bridge;
 mod patch;
 
 use crate::quads::{QuadDefect, QuadMesh, SurfacePoint};
@@ -37,17 +39,38 @@ pub(super) fn fill_holes(mesh: &TriMesh, quads: &mut QuadMesh) {
         let what = format!("{opened} quads where the traced mesh is not a manifold removed (the hole is filled)");
         quads.defects.push(QuadDefect { face, what });
     }
-    for hole in holes(quads).0 {
+    let holes = holes(quads).0;
+    let on: Vec<Vec<bool>> = holes.iter().map(|h| h.iter().map(|&v| on_input_boundary(mesh, quads.locations[v as usize])).collect()).collect();
+    // Holes off the boundary whose quads are pieces cut off from the rest are joined in pairs.
+    let inside: Vec<usize> = (0..holes.len()).filter(|&i| !on[i].contains(&true)).collect();
+    let inside_holes: Vec<Vec<u32>> = inside.iter().map(|&i| holes[i].clone()).collect();
+    let mut joined = vec![false; holes.len()];
+    for (x, y) in bridge::pairs_to_join(mesh, quads, &inside_holes) {
+        let (i, j) = (inside[x], inside[y]);
+        let added = bridge::join(quads, &holes[i], &holes[j]);
+        let what = format!(
+            "holes of {} and {} quad edges on either side of a ring where the map is invalid; joined with {added} quads",
+            holes[i].len(),
+            holes[j].len()
+        );
+        quads.defects.push(QuadDefect { face: quads.locations[holes[i][0] as usize].face, what });
+        joined[i] = true;
+        joined[j] = true;
+    }
+    for (k, hole) in holes.into_iter().enumerate() {
+        if joined[k] {
+            continue;
+        }
         let first = quads.locations[hole[0] as usize].face;
         let n = hole.len();
-        let on: Vec<bool> = hole.iter().map(|&v| on_input_boundary(mesh, quads.locations[v as usize])).collect();
+        let on = &on[k];
         let on_boundary = on.iter().filter(|&&b| b).count();
         if on_boundary == n {
             continue; // the input's own boundary
         }
         let what = if on_boundary > 0 {
             let at = format!("hole of {n} quad edges at the input's boundary where the map is invalid");
-            match fill_boundary_runs(mesh, quads, &hole, &on) {
+            match fill_boundary_runs(mesh, quads, &hole, on) {
                 (added, None) => format!("{at}; closed with {added} quads"),
                 (0, Some(why)) => format!("{at}; left open: {why}"),
                 (added, Some(why)) => format!("{at}; partly closed with {added} quads, left open where {why}"),

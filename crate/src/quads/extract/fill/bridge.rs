@@ -1,0 +1,139 @@
+//! Holes in pairs. Where the quads removed or skipped form a ring (around a
+//! horn, say), the traced quads fall into two pieces, each with one hole:
+//! filling both with disks would make two closed surfaces of one. While the
+//! quads have more pieces than the input, the nearest two holes of
+//! different pieces are joined by a strip of quads instead.
+
+use crate::quads::QuadMesh;
+use crate::vec3::{norm, sub, V3};
+use crate::TriMesh;
+
+/// Two holes are joined only when their centres are at most this many times
+/// the mean of their perimeters apart.
+const MAX_GAP: f64 = 0.5;
+
+/// Pairs of `holes` (indices) to join so that `quads` has no more pieces
+/// than `mesh` has components: nearest centres first, holes of different
+/// pieces with an even number of sides in all.
+pub(super) fn pairs_to_join(mesh: &TriMesh, quads: &QuadMesh, holes: &[Vec<u32>]) -> Vec<(usize, usize)> {
+    let mut piece = pieces(quads);
+    let mut excess = {
+        let mut ids: Vec<u32> = quads.quads.iter().map(|q| piece.find(q[0])).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids.len().saturating_sub(mesh.n_components())
+    };
+    let centre = |h: &[u32]| -> V3 {
+        let mut c = [0.0; 3];
+        for &v in h {
+            let p = quads.positions[v as usize];
+            for i in 0..3 {
+                c[i] += p[i] / h.len() as f64;
+            }
+        }
+        c
+    };
+    let perimeter = |h: &[u32]| -> f64 {
+        (0..h.len()).map(|i| norm(sub(quads.positions[h[(i + 1) % h.len()] as usize], quads.positions[h[i] as usize]))).sum()
+    };
+    let mut candidates: Vec<(f64, usize, usize)> = Vec::new();
+    for i in 0..holes.len() {
+        for j in i + 1..holes.len() {
+            let (a, b) = (&holes[i], &holes[j]);
+            if (a.len() + b.len()) % 2 == 1 {
+                continue;
+            }
+            let gap = norm(sub(centre(a), centre(b)));
+            if gap <= MAX_GAP * 0.5 * (perimeter(a) + perimeter(b)) {
+                candidates.push((gap, i, j));
+            }
+        }
+    }
+    candidates.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let mut used = vec![false; holes.len()];
+    let mut out = Vec::new();
+    for (_, i, j) in candidates {
+        if excess == 0 {
+            break;
+        }
+        let (pi, pj) = (piece.find(holes[i][0]), piece.find(holes[j][0]));
+        if used[i] || used[j] || pi == pj {
+            continue;
+        }
+        piece.union(pi, pj);
+        used[i] = true;
+        used[j] = true;
+        excess -= 1;
+        out.push((i, j));
+    }
+    out
+}
+
+/// Joins the holes `a` and `b` (each oriented as a face filling it would
+/// be; together an even number of sides) by a strip of quads: from the
+/// nearest pair of their vertices, around both, each quad taking a side of
+/// each (or, where one is longer, two sides of it) by the shorter new
+/// diagonal. The number of quads added (unit-square corner UVs).
+pub(super) fn join(quads: &mut QuadMesh, a: &[u32], b: &[u32]) -> usize {
+    let (n, m) = (a.len(), b.len());
+    let p = |v: u32| quads.positions[v as usize];
+    let d = |x: u32, y: u32| norm(sub(p(x), p(y)));
+    let s = (0..m).min_by(|&x, &y| d(a[0], b[x]).total_cmp(&d(a[0], b[y]))).expect("a hole has sides");
+    // Vertex of b `j` sides back from b[s], walking against b's orientation.
+    let back = |j: usize| b[(s + m * 2 - j % m) % m];
+    let (mut i, mut j) = (0, 0);
+    let mut added = Vec::new();
+    while i < n || j < m {
+        let (ra, rb) = (n - i, m - j);
+        let mut options: Vec<(f64, [u32; 4], usize, usize)> = Vec::new();
+        if ra >= 1 && rb >= 1 {
+            options.push((d(a[(i + 1) % n], back(j + 1)), [a[i % n], a[(i + 1) % n], back(j + 1), back(j)], 1, 1));
+        }
+        if ra >= 2 && ra >= rb + 2 {
+            options.push((d(a[(i + 2) % n], back(j)), [a[i % n], a[(i + 1) % n], a[(i + 2) % n], back(j)], 2, 0));
+        }
+        if rb >= 2 && rb >= ra + 2 {
+            options.push((d(a[i % n], back(j + 2)), [a[i % n], back(j + 2), back(j + 1), back(j)], 0, 2));
+        }
+        let Some(&(_, quad, di, dj)) = options.iter().min_by(|x, y| x.0.total_cmp(&y.0)) else { break };
+        added.push(quad);
+        (i, j) = (i + di, j + dj);
+    }
+    for quad in &added {
+        quads.quads.push(*quad);
+        quads.uv.extend([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+    }
+    added.len()
+}
+
+/// Union-find over quad vertices joined by quads.
+struct Pieces(Vec<u32>);
+
+impl Pieces {
+    fn find(&mut self, mut v: u32) -> u32 {
+        while self.0[v as usize] != v {
+            let up = self.0[self.0[v as usize] as usize];
+            self.0[v as usize] = up;
+            v = up;
+        }
+        v
+    }
+
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            self.0[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+}
+
+/// The pieces of `quads` (vertices joined through quads).
+fn pieces(quads: &QuadMesh) -> Pieces {
+    let mut p = Pieces((0..quads.positions.len() as u32).collect());
+    for q in &quads.quads {
+        for &v in &q[1..] {
+            p.union(q[0], v);
+        }
+    }
+    p
+}
