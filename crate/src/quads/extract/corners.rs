@@ -118,6 +118,7 @@ pub(super) fn align_curve_corners(mesh: &TriMesh, features: &FeatureSet, quads: 
         }
         quads.positions[v as usize] = target;
         quads.locations[v as usize] = vertex_location(mesh, c, quads.locations[v as usize]);
+        on_curve[v as usize] = Some(OnCurve::Vertex(c));
         moved[v as usize] = true;
         count += 1;
     }
