@@ -24,14 +24,8 @@ const MAX_FLIPS_PER_EDGE: usize = 8;
 /// that are not coplanar, where the two angles opposite it sum to more than
 /// π, until none is left (Lawson's algorithm: on each plane the result is
 /// its Delaunay triangulation). Returns `current` when nothing was flipped.
-pub(super) fn flip_coplanar(
-    mesh: &TriMesh,
-    features: &FeatureSet,
-    current: Option<Refined>,
-) -> Option<Refined> {
-    let (m, f) = current
-        .as_ref()
-        .map_or((mesh, features), |r| (&r.mesh, &r.features));
+pub(super) fn flip_coplanar(mesh: &TriMesh, features: &FeatureSet, current: Option<Refined>) -> Option<Refined> {
+    let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
     let mut faces = m.faces().to_vec();
     let positions = m.positions();
     let tolerance = COPLANAR * m.bounding_diagonal();
@@ -40,10 +34,7 @@ pub(super) fn flip_coplanar(
     let mut edge_faces: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(m.n_edges());
     for (i, t) in faces.iter().enumerate() {
         for k in 0..3 {
-            edge_faces
-                .entry(key(t[k], t[(k + 1) % 3]))
-                .or_default()
-                .push(i as u32);
+            edge_faces.entry(key(t[k], t[(k + 1) % 3])).or_default().push(i as u32);
         }
     }
     let fixed: std::collections::HashSet<(u32, u32)> = f
@@ -69,11 +60,7 @@ pub(super) fn flip_coplanar(
             continue;
         }
         // Orient: f1 = (a, b, c) runs a -> b, f2 = (b, a, d).
-        let (a, b) = if runs(&faces[f1], a, b) {
-            (a, b)
-        } else {
-            (b, a)
-        };
+        let (a, b) = if runs(&faces[f1], a, b) { (a, b) } else { (b, a) };
         let (c, d) = (third(&faces[f1], a, b), third(&faces[f2], b, a));
         if edge_faces.contains_key(&key(c, d)) {
             continue;
@@ -94,9 +81,7 @@ pub(super) fn flip_coplanar(
         }
         // The new faces (a, d, c) and (d, b, c) must keep the orientation.
         let n = crate::vec3::add(n1, n2);
-        if dot(cross(sub(p(d), p(a)), sub(p(c), p(a))), n) <= 0.0
-            || dot(cross(sub(p(b), p(d)), sub(p(c), p(d))), n) <= 0.0
-        {
+        if dot(cross(sub(p(d), p(a)), sub(p(c), p(a))), n) <= 0.0 || dot(cross(sub(p(b), p(d)), sub(p(c), p(d))), n) <= 0.0 {
             continue;
         }
         faces[f1] = [a, d, c];
@@ -121,10 +106,7 @@ fn runs(t: &[u32; 3], a: u32, b: u32) -> bool {
 
 /// The corner of `t` other than `a` and `b`.
 fn third(t: &[u32; 3], a: u32, b: u32) -> u32 {
-    t.iter()
-        .copied()
-        .find(|&v| v != a && v != b)
-        .expect("a triangle has three corners")
+    t.iter().copied().find(|&v| v != a && v != b).expect("a triangle has three corners")
 }
 
 /// The angle at `apex` of the triangle (`apex`, `x`, `y`).
@@ -146,13 +128,7 @@ fn replace(edge_faces: &mut HashMap<(u32, u32), Vec<u32>>, e: (u32, u32), from: 
 /// any, with features `f`) with its faces replaced by `faces` (the same
 /// vertices, some edges flipped). A flipped face's input face is the one
 /// that holds its centroid; a flipped edge is inside the input's faces (`NONE`).
-fn rebuild(
-    m: &TriMesh,
-    f: &FeatureSet,
-    current: Option<&Refined>,
-    faces: Vec<[u32; 3]>,
-    flips: usize,
-) -> Refined {
+fn rebuild(m: &TriMesh, f: &FeatureSet, current: Option<&Refined>, faces: Vec<[u32; 3]>, flips: usize) -> Refined {
     let input_face_of = |g: u32| current.map_or(g, |r| r.original_face[g as usize]);
     let original_face: Vec<u32> = faces
         .iter()
@@ -161,14 +137,12 @@ fn rebuild(
             if *t == m.faces()[g] {
                 input_face_of(g as u32)
             } else {
-                let centroid =
-                    [0, 1, 2].map(|i| t.iter().map(|&v| m.position(v)[i]).sum::<f64>() / 3.0);
+                let centroid = [0, 1, 2].map(|i| t.iter().map(|&v| m.position(v)[i]).sum::<f64>() / 3.0);
                 input_face_of(locate(m, t[0], centroid))
             }
         })
         .collect();
-    let built = TriMesh::from_welded_arrays(m.positions().to_vec(), faces)
-        .expect("flipping coplanar edges keeps the mesh valid");
+    let built = TriMesh::from_welded_arrays(m.positions().to_vec(), faces).expect("flipping coplanar edges keeps the mesh valid");
     let old: Vec<u32> = built.welded_to_source().to_vec();
     let mesh = TriMesh::from_welded_arrays(built.positions().to_vec(), built.faces().to_vec())
         .expect("rebuilding a valid mesh from its own arrays");
@@ -184,21 +158,10 @@ fn rebuild(
             original_edge[e as usize] = current.map_or(pe, |r| r.original_edge[pe as usize]);
         }
     }
-    let original_vertex = old
-        .iter()
-        .map(|&s| current.map_or(s, |r| r.original_vertex[s as usize]))
-        .collect();
+    let original_vertex = old.iter().map(|&s| current.map_or(s, |r| r.original_vertex[s as usize])).collect();
     let mut counts = current.map_or(Default::default(), |r| r.counts);
     counts.coplanar_flips += flips;
-    Refined {
-        mesh,
-        features,
-        original_face,
-        original_vertex,
-        original_edge,
-        splits: current.map_or(0, |r| r.splits),
-        counts,
-    }
+    Refined { mesh, features, original_face, original_vertex, original_edge, splits: current.map_or(0, |r| r.splits), counts }
 }
 
 /// Faces [`locate`] visits before it settles for the nearest one seen.
@@ -236,10 +199,7 @@ fn locate(m: &TriMesh, start: u32, p: V3) -> u32 {
 /// Distance from `p` to face `face` of `input`.
 fn distance_to_face(input: &TriMesh, face: u32, p: V3) -> f64 {
     let t = input.faces()[face as usize].map(|v| input.position(v));
-    norm(sub(
-        p,
-        crate::vec3::barycentric_point(&t, closest_point_barycentric(p, &t)),
-    ))
+    norm(sub(p, crate::vec3::barycentric_point(&t, closest_point_barycentric(p, &t))))
 }
 
 #[cfg(test)]
@@ -247,11 +207,7 @@ mod tests {
     use super::*;
 
     fn min_angle(m: &TriMesh) -> f64 {
-        m.corner_angles()
-            .iter()
-            .flatten()
-            .copied()
-            .fold(f64::INFINITY, f64::min)
+        m.corner_angles().iter().flatten().copied().fold(f64::INFINITY, f64::min)
     }
 
     /// A fan over `n` points of a flat 5 x 1 ellipse: slivers from vertex 0.
@@ -261,11 +217,7 @@ mod tests {
             let a = 2.0 * PI * i as f64 / n as f64;
             [5.0 * a.cos(), a.sin(), 0.0]
         });
-        TriMesh::from_welded_arrays(
-            positions.collect(),
-            (1..n - 1).map(|i| [0, i, i + 1]).collect(),
-        )
-        .unwrap()
+        TriMesh::from_welded_arrays(positions.collect(), (1..n - 1).map(|i| [0, i, i + 1]).collect()).unwrap()
     }
 
     /// A fan of slivers is flipped into a Delaunay triangulation of the same
@@ -276,42 +228,24 @@ mod tests {
     fn a_fan_of_slivers_becomes_delaunay_and_the_surface_stays() {
         let m = ellipse_fan(24);
         let mut f = FeatureSet::none(&m);
-        let diagonal = m
-            .outgoing(0)
-            .find(|&h| m.head(h) == 12)
-            .map(|h| m.edge(h))
-            .unwrap();
+        let diagonal = m.outgoing(0).find(|&h| m.head(h) == 12).map(|h| m.edge(h)).unwrap();
         f.set(&m, diagonal, true);
         let r = flip_coplanar(&m, &f, None).expect("the fan is not Delaunay");
         assert!(r.counts.coplanar_flips > 0);
-        assert_eq!(
-            (r.mesh.n_vertices(), r.mesh.n_faces(), r.splits),
-            (m.n_vertices(), m.n_faces(), 0)
-        );
+        assert_eq!((r.mesh.n_vertices(), r.mesh.n_faces(), r.splits), (m.n_vertices(), m.n_faces(), 0));
         let area = |m: &TriMesh| m.face_areas().iter().sum::<f64>();
         assert!((area(&r.mesh) - area(&m)).abs() < 1e-12 * area(&m));
         for v in 0..r.mesh.n_vertices() as u32 {
-            assert_eq!(
-                r.mesh.position(v),
-                m.position(r.original_vertex[v as usize])
-            );
+            assert_eq!(r.mesh.position(v), m.position(r.original_vertex[v as usize]));
         }
         assert_eq!(r.features.len(), 1);
         let kept = r.features.edges().next().unwrap();
         assert_eq!(r.original_edge[kept as usize], diagonal);
-        assert!(
-            min_angle(&r.mesh) > 2.0 * min_angle(&m),
-            "{} -> {}",
-            min_angle(&m),
-            min_angle(&r.mesh)
-        );
+        assert!(min_angle(&r.mesh) > 2.0 * min_angle(&m), "{} -> {}", min_angle(&m), min_angle(&r.mesh));
         // Each face overlaps its input face (its centroid lies in it).
         for (g, t) in r.mesh.faces().iter().enumerate() {
             let c = [0, 1, 2].map(|i| t.iter().map(|&v| r.mesh.position(v)[i]).sum::<f64>() / 3.0);
-            assert!(
-                distance_to_face(&m, r.original_face[g], c) < 1e-12,
-                "face {g}"
-            );
+            assert!(distance_to_face(&m, r.original_face[g], c) < 1e-12, "face {g}");
         }
         assert!(flip_coplanar(&r.mesh, &r.features, None).is_none());
     }
@@ -320,19 +254,13 @@ mod tests {
     #[test]
     fn a_fold_is_not_flipped() {
         let pair = |z: f64| {
-            let positions = vec![
-                [0.0, 0.0, 0.0],
-                [10.0, 0.0, 0.0],
-                [5.0, 0.1, 0.0],
-                [5.0, -0.1, z],
-            ];
+            let positions = vec![[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [5.0, 0.1, 0.0], [5.0, -0.1, z]];
             TriMesh::from_welded_arrays(positions, vec![[0, 1, 2], [1, 0, 3]]).unwrap()
         };
         let folded = pair(1e-3);
         assert!(flip_coplanar(&folded, &FeatureSet::none(&folded), None).is_none());
         let flat = pair(0.0);
-        let r =
-            flip_coplanar(&flat, &FeatureSet::none(&flat), None).expect("a flat sliver pair flips");
+        let r = flip_coplanar(&flat, &FeatureSet::none(&flat), None).expect("a flat sliver pair flips");
         assert_eq!(r.counts.coplanar_flips, 1);
         assert_eq!(r.original_edge.iter().filter(|&&e| e == NONE).count(), 1);
     }
