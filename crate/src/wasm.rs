@@ -309,8 +309,11 @@ impl MeshSession {
 
     /// The integer-grid map of the last solve for about `quads` grid cells
     /// and the quad mesh traced on it (a [`QuadsResult`]); re-runs only
-    /// quantization and extraction. Throws when nothing was solved yet, or
-    /// with the quantization error (a free boundary, say).
+    /// quantization and extraction, except on the first call for a mesh
+    /// with edges longer than a quad mesh wants: the map is then solved
+    /// again on its refinement (`pipeline::quads_refine`; where that solve
+    /// fails, the last solve's map is used). Throws when nothing was solved
+    /// yet, or with the quantization error (a free boundary, say).
     pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
         self.valid_mesh()?;
         let (Some(input), Some(grid)) = (self.mesh.as_ref(), self.grid.as_mut()) else {
@@ -318,8 +321,11 @@ impl MeshSession {
         };
         if let Some(refine) = pipeline::quads_refine(input, &grid.options.refine) {
             let options = SolveOptions { refine, ..grid.options };
-            let sol = pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)).map_err(|e| solve_error(&e))?;
-            *grid = GridStage { solution: sol.into_owned(), quantizer: None, features: grid.features.clone(), options };
+            match pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)) {
+                Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, features: grid.features.clone(), options },
+                // Quads on the map the page shows rather than none; not asked again.
+                Err(_) => grid.options = options,
+            }
         }
         if grid.quantizer.is_none() {
             grid.quantizer = Some(grid.solution.quantizer().map_err(|e| JsError::new(&e.to_string()))?);
