@@ -65,6 +65,22 @@ pub fn segment_parameter(p: V3, a: V3, b: V3) -> f64 {
     }
 }
 
+/// The angle between `u` and `w`, in `[0, π]`.
+pub fn angle(u: V3, w: V3) -> f64 {
+    norm(cross(u, w)).atan2(dot(u, w))
+}
+
+/// Distance from `p` to the segment `[a, b]` (a point when `a == b`).
+pub fn point_segment_distance(p: V3, a: V3, b: V3) -> f64 {
+    let t = segment_parameter(p, a, b);
+    norm(sub(p, add(a, scale(sub(b, a), t))))
+}
+
+/// Distance from `p` to the triangle `t` (see [`closest_point_barycentric`]).
+pub fn point_triangle_distance(p: V3, t: &[V3; 3]) -> f64 {
+    norm(sub(p, barycentric_point(t, closest_point_barycentric(p, t))))
+}
+
 /// The point `Σ bary[k] · t[k]`.
 pub fn barycentric_point(t: &[V3; 3], bary: [f64; 3]) -> V3 {
     [0, 1, 2].map(|i| bary[0] * t[0][i] + bary[1] * t[1][i] + bary[2] * t[2][i])

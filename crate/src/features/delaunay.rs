@@ -4,10 +4,10 @@
 //! lie in one plane are flipped, never a feature or boundary edge, so the
 //! surface, its features and its boundary stay exactly as they were.
 
-use super::refine::Refined;
+use super::refine::{refined_from, RefineCounts, Refined};
 use super::FeatureSet;
-use crate::mesh::{TriMesh, NONE};
-use crate::vec3::{closest_point_barycentric, cross, dot, norm, sub, V3};
+use crate::mesh::TriMesh;
+use crate::vec3::{angle, cross, dot, norm, point_triangle_distance, sub, V3};
 use std::collections::HashMap;
 
 /// Two triangles are coplanar when each one's far corner lies within this
@@ -76,7 +76,7 @@ pub(super) fn flip_coplanar(mesh: &TriMesh, features: &FeatureSet, current: Opti
         if height(n1, l1, a, d) > tolerance || height(n2, l2, b, c) > tolerance {
             continue;
         }
-        if angle(p(c), p(a), p(b)) + angle(p(d), p(b), p(a)) <= std::f64::consts::PI + 1e-12 {
+        if angle(sub(p(a), p(c)), sub(p(b), p(c))) + angle(sub(p(b), p(d)), sub(p(a), p(d))) <= std::f64::consts::PI + 1e-12 {
             continue;
         }
         // The new faces (a, d, c) and (d, b, c) must keep the orientation.
@@ -109,12 +109,6 @@ fn third(t: &[u32; 3], a: u32, b: u32) -> u32 {
     t.iter().copied().find(|&v| v != a && v != b).expect("a triangle has three corners")
 }
 
-/// The angle at `apex` of the triangle (`apex`, `x`, `y`).
-fn angle(apex: V3, x: V3, y: V3) -> f64 {
-    let (u, v) = (sub(x, apex), sub(y, apex));
-    norm(cross(u, v)).atan2(dot(u, v))
-}
-
 /// Face `from` on edge `e` becomes face `to`.
 fn replace(edge_faces: &mut HashMap<(u32, u32), Vec<u32>>, e: (u32, u32), from: u32, to: u32) {
     if let Some(fs) = edge_faces.get_mut(&e) {
@@ -126,52 +120,37 @@ fn replace(edge_faces: &mut HashMap<(u32, u32), Vec<u32>>, e: (u32, u32), from: 
 
 /// The refinement of the input given by `m` (its refinement `current`, if
 /// any, with features `f`) with its faces replaced by `faces` (the same
-/// vertices, some edges flipped). A flipped face's input face is the one
-/// that holds its centroid; a flipped edge is inside the input's faces (`NONE`).
+/// vertices, `flips` edges flipped). A flipped face lies in the face of `m`
+/// that holds its centroid; a flipped edge is inside the input's faces.
 fn rebuild(m: &TriMesh, f: &FeatureSet, current: Option<&Refined>, faces: Vec<[u32; 3]>, flips: usize) -> Refined {
-    let input_face_of = |g: u32| current.map_or(g, |r| r.original_face[g as usize]);
-    let original_face: Vec<u32> = faces
+    let tolerance = LOCATE_TOLERANCE * m.bounding_diagonal();
+    let parent: Vec<u32> = faces
         .iter()
         .enumerate()
         .map(|(g, t)| {
             if *t == m.faces()[g] {
-                input_face_of(g as u32)
+                g as u32
             } else {
                 let centroid = [0, 1, 2].map(|i| t.iter().map(|&v| m.position(v)[i]).sum::<f64>() / 3.0);
-                input_face_of(locate(m, t[0], centroid))
+                locate(m, t[0], centroid, tolerance)
             }
         })
         .collect();
-    let built = TriMesh::from_welded_arrays(m.positions().to_vec(), faces).expect("flipping coplanar edges keeps the mesh valid");
-    let old: Vec<u32> = built.welded_to_source().to_vec();
-    let mesh = TriMesh::from_welded_arrays(built.positions().to_vec(), built.faces().to_vec())
-        .expect("rebuilding a valid mesh from its own arrays");
-    let edge_of_m = |a: u32, b: u32| m.outgoing(a).find(|&h| m.head(h) == b).map(|h| m.edge(h));
-    let mut features = FeatureSet::none(&mesh);
-    let mut original_edge = vec![NONE; mesh.n_edges()];
-    for e in 0..mesh.n_edges() as u32 {
-        let [a, b] = mesh.edge_vertices(e).map(|v| old[v as usize]);
-        if let Some(pe) = edge_of_m(a, b) {
-            if f.contains(pe) {
-                features.set(&mesh, e, true);
-            }
-            original_edge[e as usize] = current.map_or(pe, |r| r.original_edge[pe as usize]);
-        }
-    }
-    let original_vertex = old.iter().map(|&s| current.map_or(s, |r| r.original_vertex[s as usize])).collect();
-    let mut counts = current.map_or(Default::default(), |r| r.counts);
-    counts.coplanar_flips += flips;
-    Refined { mesh, features, original_face, original_vertex, original_edge, splits: current.map_or(0, |r| r.splits), counts }
+    let added = RefineCounts { coplanar_flips: flips, ..RefineCounts::default() };
+    refined_from(m, f, current, m.positions().to_vec(), faces, &parent, &[], &added)
 }
+
+/// A point is in a face when within this fraction of the bounding-box
+/// diagonal of it ([`locate`]).
+const LOCATE_TOLERANCE: f64 = 1e-9;
 
 /// Faces [`locate`] visits before it settles for the nearest one seen.
 const MAX_LOCATE_FACES: usize = 4096;
 
 /// The face of `m` that holds `p`, a point of `m`'s surface near vertex
 /// `start`: faces are visited breadth first from those around `start` until
-/// one holds `p` (within rounding), else the nearest of those visited.
-fn locate(m: &TriMesh, start: u32, p: V3) -> u32 {
-    let tolerance = 1e-9 * m.bounding_diagonal();
+/// one is within `tolerance` of `p`, else the nearest of those visited.
+fn locate(m: &TriMesh, start: u32, p: V3, tolerance: f64) -> u32 {
     let mut seen: std::collections::HashSet<u32> = m.vertex_faces(start).collect();
     let mut queue: std::collections::VecDeque<u32> = seen.iter().copied().collect();
     let mut nearest = (f64::INFINITY, queue[0]);
@@ -196,15 +175,15 @@ fn locate(m: &TriMesh, start: u32, p: V3) -> u32 {
     nearest.1
 }
 
-/// Distance from `p` to face `face` of `input`.
-fn distance_to_face(input: &TriMesh, face: u32, p: V3) -> f64 {
-    let t = input.faces()[face as usize].map(|v| input.position(v));
-    norm(sub(p, crate::vec3::barycentric_point(&t, closest_point_barycentric(p, &t))))
+/// Distance from `p` to face `face` of `m`.
+fn distance_to_face(m: &TriMesh, face: u32, p: V3) -> f64 {
+    point_triangle_distance(p, &m.faces()[face as usize].map(|v| m.position(v)))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::NONE;
 
     fn min_angle(m: &TriMesh) -> f64 {
         m.corner_angles().iter().flatten().copied().fold(f64::INFINITY, f64::min)

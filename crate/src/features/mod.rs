@@ -15,10 +15,7 @@ mod refine;
 
 pub use cut::{boundary_turning, cut_open, CutMesh};
 pub use detect::{detect_sharp, MinLength, SharpDetection, SharpOptions, SharpStats};
-pub use refine::{
-    refine_for_features, refine_for_features_on, split_around, split_flipped, split_long_edges,
-    RefineCounts, Refined,
-};
+pub use refine::{refine_for_features, refine_for_features_on, split_around, split_flipped, split_long_edges, RefineCounts, Refined};
 
 use crate::mesh::TriMesh;
 use locate::VertexLocator;

@@ -320,7 +320,6 @@ impl Splits {
     /// `current` of the input, if any) by these splits. Vertices of `m` keep
     /// their indices; inserted ones follow.
     fn apply(self, m: &TriMesh, f: &FeatureSet, current: Option<&Refined>) -> Refined {
-        let nv = m.n_vertices();
         let mut positions = m.positions().to_vec();
         // Midpoint vertex of each split edge, and the edge each midpoint splits.
         let mut mid = vec![NONE; m.n_edges()];
@@ -333,7 +332,6 @@ impl Splits {
                 positions.push(crate::vec3::midpoint(m.position(a), m.position(b)));
             }
         }
-        let n_mid = mid_of.len();
         let mut triangles = Vec::with_capacity(m.n_faces() + 2 * self.claimed.iter().filter(|&&c| c).count());
         let mut parent = Vec::with_capacity(triangles.capacity());
         for face in 0..m.n_faces() as u32 {
@@ -356,47 +354,69 @@ impl Splits {
                 parent.push(face);
             }
         }
-        let inserted = positions.len() - nv;
-        let built = TriMesh::from_welded_arrays(positions, triangles).expect("inserting vertices inside faces or edges keeps the mesh valid");
-        // The builder numbers vertices by first use; rebuild from its own
-        // arrays so that the refined mesh is its own source.
-        let old: Vec<u32> = built.welded_to_source().to_vec();
-        let mesh = TriMesh::from_welded_arrays(built.positions().to_vec(), built.faces().to_vec())
-            .expect("rebuilding a valid mesh from its own arrays");
-        // Each refined edge is an edge of m, half of a split edge, or new.
-        let edge_of_m = |a: u32, b: u32| m.outgoing(a).find(|&h| m.head(h) == b).map(|h| m.edge(h));
-        let parent_edge = |e: u32| -> Option<u32> {
-            let [a, b] = mesh.edge_vertices(e).map(|v| old[v as usize]);
-            let (lo, hi) = (a.min(b) as usize, a.max(b) as usize);
-            if hi < nv {
-                edge_of_m(lo as u32, hi as u32)
-            } else if lo < nv && hi < nv + n_mid {
-                let split = mid_of[hi - nv];
-                m.edge_vertices(split).contains(&(lo as u32)).then_some(split)
-            } else {
-                None
-            }
-        };
-        let mut features = FeatureSet::none(&mesh);
-        let mut original_edge = vec![NONE; mesh.n_edges()];
-        for e in 0..mesh.n_edges() as u32 {
-            if let Some(pe) = parent_edge(e) {
-                if f.contains(pe) {
-                    features.set(&mesh, e, true);
-                }
-                original_edge[e as usize] = current.map_or(pe, |r| r.original_edge[pe as usize]);
-            }
-        }
-        let original_vertex = old
-            .iter()
-            .map(|&s| if (s as usize) >= nv { NONE } else { current.map_or(s, |r| r.original_vertex[s as usize]) })
-            .collect();
-        let original_face = parent.iter().map(|&g| current.map_or(g, |r| r.original_face[g as usize])).collect();
-        let mut counts = current.map_or(RefineCounts::default(), |r| r.counts);
-        counts.add(&self.counts);
-        let splits = current.map_or(0, |r| r.splits) + inserted;
-        Refined { mesh, features, original_face, original_vertex, original_edge, splits, counts }
+        refined_from(m, f, current, positions, triangles, &parent, &mid_of, &self.counts)
     }
+}
+
+/// The refinement of the input whose mesh is `m` (itself the refinement
+/// `current` of the input, if any, with features `f`) remade as
+/// `triangles` over `positions`: the vertices of `m` first, then the
+/// midpoints of the edges `mid_of` of `m` in that order, then any others
+/// (centroids); `parent` the face of `m` each triangle lies in; `added`
+/// what was done. Refined vertices are renumbered by first use; edges of
+/// `m` and halves of split edges carry their input edge and feature flag.
+pub(super) fn refined_from(
+    m: &TriMesh,
+    f: &FeatureSet,
+    current: Option<&Refined>,
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    parent: &[u32],
+    mid_of: &[u32],
+    added: &RefineCounts,
+) -> Refined {
+    let nv = m.n_vertices();
+    let n_mid = mid_of.len();
+    let inserted = positions.len() - nv;
+    let built = TriMesh::from_welded_arrays(positions, triangles).expect("inserting vertices inside faces or edges, or flipping coplanar edges, keeps the mesh valid");
+    // The builder numbers vertices by first use; rebuild from its own
+    // arrays so that the refined mesh is its own source.
+    let old: Vec<u32> = built.welded_to_source().to_vec();
+    let mesh = TriMesh::from_welded_arrays(built.positions().to_vec(), built.faces().to_vec())
+        .expect("rebuilding a valid mesh from its own arrays");
+    // Each refined edge is an edge of m, half of a split edge, or new.
+    let edge_of_m = |a: u32, b: u32| m.outgoing(a).find(|&h| m.head(h) == b).map(|h| m.edge(h));
+    let parent_edge = |e: u32| -> Option<u32> {
+        let [a, b] = mesh.edge_vertices(e).map(|v| old[v as usize]);
+        let (lo, hi) = (a.min(b) as usize, a.max(b) as usize);
+        if hi < nv {
+            edge_of_m(lo as u32, hi as u32)
+        } else if lo < nv && hi < nv + n_mid {
+            let split = mid_of[hi - nv];
+            m.edge_vertices(split).contains(&(lo as u32)).then_some(split)
+        } else {
+            None
+        }
+    };
+    let mut features = FeatureSet::none(&mesh);
+    let mut original_edge = vec![NONE; mesh.n_edges()];
+    for e in 0..mesh.n_edges() as u32 {
+        if let Some(pe) = parent_edge(e) {
+            if f.contains(pe) {
+                features.set(&mesh, e, true);
+            }
+            original_edge[e as usize] = current.map_or(pe, |r| r.original_edge[pe as usize]);
+        }
+    }
+    let original_vertex = old
+        .iter()
+        .map(|&s| if (s as usize) >= nv { NONE } else { current.map_or(s, |r| r.original_vertex[s as usize]) })
+        .collect();
+    let original_face = parent.iter().map(|&g| current.map_or(g, |r| r.original_face[g as usize])).collect();
+    let mut counts = current.map_or(RefineCounts::default(), |r| r.counts);
+    counts.add(added);
+    let splits = current.map_or(0, |r| r.splits) + inserted;
+    Refined { mesh, features, original_face, original_vertex, original_edge, splits, counts }
 }
 
 #[cfg(test)]
@@ -486,11 +506,7 @@ mod tests {
         let length = 0.3;
         let r = split_long_edges(&m, &f, None, length).expect("the cylinder has long edges");
         assert!((0..r.mesh.n_edges() as u32).all(|e| r.mesh.edge_length(e) <= length));
-        assert!(
-            r.counts.long_edges > 0 && r.counts.coplanar_flips > 0,
-            "{:?}",
-            r.counts
-        );
+        assert!(r.counts.long_edges > 0 && r.counts.coplanar_flips > 0, "{:?}", r.counts);
         assert_eq!(r.splits, r.mesh.n_vertices() - m.n_vertices());
         assert_eq!(r.mesh.euler_characteristic(), m.euler_characteristic());
         let total = |m: &TriMesh, f: &FeatureSet| f.edges().map(|e| m.edge_length(e)).sum::<f64>();
@@ -499,14 +515,8 @@ mod tests {
         assert!((area(&r.mesh) - area(&m)).abs() < 1e-9 * area(&m));
         for v in 0..r.mesh.n_vertices() as u32 {
             let p = r.mesh.position(v);
-            let on = (0..m.n_faces() as u32).any(|g| {
-                let t = m.faces()[g as usize].map(|x| m.position(x));
-                let q = crate::vec3::barycentric_point(
-                    &t,
-                    crate::vec3::closest_point_barycentric(p, &t),
-                );
-                crate::vec3::norm(crate::vec3::sub(p, q)) < 1e-12
-            });
+            let on = (0..m.n_faces() as u32)
+                .any(|g| crate::vec3::point_triangle_distance(p, &m.faces()[g as usize].map(|x| m.position(x))) < 1e-12);
             assert!(on, "vertex {v} is off the input");
         }
         assert!(split_long_edges(&r.mesh, &r.features, None, length).is_none());

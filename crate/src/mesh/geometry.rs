@@ -112,7 +112,7 @@ impl TriMesh {
     /// Interior angle (radians, in `[0, π]`) at each corner: `[f][k]` is the
     /// angle of face `f` at vertex `faces()[f][k]` (atan2 form, robust near 0 and π).
     pub fn corner_angles(&self) -> &[[f64; 3]] {
-        self.geometry.corner_angles.get_or_init(|| per_corner(self, |u, v| norm(cross(u, v)).atan2(dot(u, v))))
+        self.geometry.corner_angles.get_or_init(|| per_corner(self, crate::vec3::angle))
     }
 
     /// Cotangent of each corner angle, laid out like [`TriMesh::corner_angles`]

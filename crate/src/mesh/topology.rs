@@ -142,4 +142,11 @@ impl UnionFind {
             self.parent[hi as usize] = lo;
         }
     }
+    /// Number of distinct sets among `members`.
+    pub fn count_sets(&mut self, members: impl Iterator<Item = u32>) -> usize {
+        let mut roots: Vec<u32> = members.map(|x| self.find(x)).collect();
+        roots.sort_unstable();
+        roots.dedup();
+        roots.len()
+    }
 }

@@ -14,9 +14,8 @@
 //! cost is about linear in the number of samples and primitives.
 
 use super::QuadMesh;
-use crate::vec3::{
-    add, barycentric_point, bounds, closest_point_barycentric, cross, dot, midpoint, norm, scale, segment_parameter, sub, V3,
-};
+use crate::mesh::UnionFind;
+use crate::vec3::{add, angle, bounds, cross, dot, midpoint, norm, point_segment_distance, point_triangle_distance, scale, sub, V3};
 use crate::TriMesh;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -254,41 +253,9 @@ fn sorted_sides(quads: &QuadMesh) -> Vec<Side> {
     sides
 }
 
-/// Union–find with path halving.
-struct DisjointSets {
-    parent: Vec<u32>,
-}
-
-impl DisjointSets {
-    fn new(n: usize) -> Self {
-        DisjointSets { parent: (0..n as u32).collect() }
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let grandparent = self.parent[self.parent[x as usize] as usize];
-            self.parent[x as usize] = grandparent;
-            x = grandparent;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.parent[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
-    /// Number of distinct sets among `members`.
-    fn count_sets(&mut self, members: impl Iterator<Item = u32>) -> usize {
-        let mut roots: Vec<u32> = members.map(|x| self.find(x)).collect();
-        roots.sort_unstable();
-        roots.dedup();
-        roots.len()
-    }
-}
-
 /// Connected components of the boundary edges.
 fn boundary_loops(nv: usize, edges: &[QuadEdge]) -> usize {
-    let mut sets = DisjointSets::new(nv);
+    let mut sets = UnionFind::new(nv);
     for e in edges.iter().filter(|e| e.is_boundary()) {
         sets.union(e.vertices[0], e.vertices[1]);
     }
@@ -297,7 +264,7 @@ fn boundary_loops(nv: usize, edges: &[QuadEdge]) -> usize {
 
 /// Edge-connected components of the quads with indices in range.
 fn components(quads: &QuadMesh, valid: &[bool]) -> usize {
-    let mut sets = DisjointSets::new(quads.n_quads());
+    let mut sets = UnionFind::new(quads.n_quads());
     let sides = sorted_sides(quads);
     for pair in sides.windows(2) {
         if pair[0].vertices == pair[1].vertices {
@@ -363,7 +330,7 @@ fn is_disk_fan(wedges: &[[u32; 2]]) -> bool {
     nodes.dedup();
     let local = |x: u32| nodes.partition_point(|&y| y < x) as u32;
     let mut degree = vec![0u32; nodes.len()];
-    let mut sets = DisjointSets::new(nodes.len());
+    let mut sets = UnionFind::new(nodes.len());
     for &[a, b] in wedges {
         let (a, b) = (local(a), local(b));
         degree[a as usize] += 1;
@@ -428,7 +395,7 @@ fn corner_angles(quads: &QuadMesh, valid: &[bool]) -> AngleStats {
                 all_good = false;
                 continue;
             }
-            let angle = norm(cross(u, w)).atan2(dot(u, w)).to_degrees();
+            let angle = angle(u, w).to_degrees();
             let deviation = (angle - 90.0).abs();
             sum += deviation;
             max = max.max(deviation);
@@ -698,17 +665,6 @@ impl BoxGrid {
 /// Distance from `p` to the box `[lo, hi]` (0 inside).
 fn box_distance(p: V3, lo: V3, hi: V3) -> f64 {
     norm([0, 1, 2].map(|i| (lo[i] - p[i]).max(p[i] - hi[i]).max(0.0)))
-}
-
-/// Distance from `p` to the segment `[a, b]` (a point when `a == b`).
-fn point_segment_distance(p: V3, a: V3, b: V3) -> f64 {
-    let t = segment_parameter(p, a, b);
-    norm(sub(p, add(a, scale(sub(b, a), t))))
-}
-
-/// Distance from `p` to the triangle `t` (see [`closest_point_barycentric`]).
-fn point_triangle_distance(p: V3, t: &[V3; 3]) -> f64 {
-    norm(sub(p, barycentric_point(t, closest_point_barycentric(p, t))))
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ use crate::features::FeatureSet;
 use crate::mesh::TriMesh;
 use crate::quads::check::newell_normal;
 use crate::quads::SurfacePoint;
-use crate::vec3::{add, cross, dot, norm, segment_parameter, sub, V3};
+use crate::vec3::{angle, cross, dot, norm, point_segment_distance, segment_parameter, sub, V3};
 
 /// Corners closer than this (a fraction of the bounding-box diagonal) to the
 /// quad edge that spans them are left alone: a quarter of the 0.2 % within
@@ -101,9 +101,8 @@ pub(super) fn align_curve_corners(mesh: &TriMesh, features: &FeatureSet, quads: 
         let sides = edges.map(|e| nearest_on_edge(mesh, &on_edge, c, e));
         let [Some((left, dl)), Some((right, dr))] = sides else { continue };
         let target = mesh.position(c);
-        let chord = (quads.positions[left as usize], quads.positions[right as usize]);
-        let on_chord = segment_point(chord.0, chord.1, target);
-        if norm(sub(on_chord, target)) <= MIN_DEVIATION * diagonal {
+        let deviation = point_segment_distance(target, quads.positions[left as usize], quads.positions[right as usize]);
+        if deviation <= MIN_DEVIATION * diagonal {
             continue;
         }
         let (v, partner, e) = if dl <= dr { (left, right, edges[0]) } else { (right, left, edges[1]) };
@@ -112,10 +111,9 @@ pub(super) fn align_curve_corners(mesh: &TriMesh, features: &FeatureSet, quads: 
         }
         // The quad edge from v away from the corner must not cut the curve
         // beyond it worse than the corner was cut.
-        let deviation = norm(sub(on_chord, target));
         let Some(far) = far_neighbour(quads, &incident[v as usize], &on_curve, v, partner) else { continue };
         let Some(between) = polyline_to(mesh, &curve, c, e, on_curve[far as usize]) else { continue };
-        let worst = |from: V3| between.iter().map(|&p| norm(sub(segment_point(from, quads.positions[far as usize], p), p))).fold(0.0, f64::max);
+        let worst = |from: V3| between.iter().map(|&p| point_segment_distance(p, from, quads.positions[far as usize])).fold(0.0, f64::max);
         if worst(target) >= deviation.max(worst(quads.positions[v as usize])) {
             continue;
         }
@@ -132,17 +130,6 @@ pub(super) fn align_curve_corners(mesh: &TriMesh, features: &FeatureSet, quads: 
 fn other_end(mesh: &TriMesh, e: u32, v: u32) -> u32 {
     let [a, b] = mesh.edge_vertices(e);
     if a == v { b } else { a }
-}
-
-/// Angle between `u` and `w`.
-fn angle(u: V3, w: V3) -> f64 {
-    norm(cross(u, w)).atan2(dot(u, w))
-}
-
-/// The point of segment `[a, b]` nearest `p`.
-fn segment_point(a: V3, b: V3, p: V3) -> V3 {
-    let t = segment_parameter(p, a, b);
-    add(a, crate::vec3::scale(sub(b, a), t))
 }
 
 /// The quad vertex inside curve edge `e` nearest to its end `c`, and its

@@ -4,6 +4,7 @@
 //! quads have more pieces than the input, the nearest two holes of
 //! different pieces are joined by a strip of quads instead.
 
+use crate::mesh::UnionFind;
 use crate::quads::QuadMesh;
 use crate::vec3::{norm, sub, V3};
 use crate::TriMesh;
@@ -17,12 +18,7 @@ const MAX_GAP: f64 = 0.5;
 /// pieces with an even number of sides in all.
 pub(super) fn pairs_to_join(mesh: &TriMesh, quads: &QuadMesh, holes: &[Vec<u32>]) -> Vec<(usize, usize)> {
     let mut piece = pieces(quads);
-    let mut excess = {
-        let mut ids: Vec<u32> = quads.quads.iter().map(|q| piece.find(q[0])).collect();
-        ids.sort_unstable();
-        ids.dedup();
-        ids.len().saturating_sub(mesh.n_components())
-    };
+    let mut excess = piece.count_sets(quads.quads.iter().map(|q| q[0])).saturating_sub(mesh.n_components());
     let centre = |h: &[u32]| -> V3 {
         let mut c = [0.0; 3];
         for &v in h {
@@ -106,30 +102,9 @@ pub(super) fn join(quads: &mut QuadMesh, a: &[u32], b: &[u32]) -> usize {
     added.len()
 }
 
-/// Union-find over quad vertices joined by quads.
-struct Pieces(Vec<u32>);
-
-impl Pieces {
-    fn find(&mut self, mut v: u32) -> u32 {
-        while self.0[v as usize] != v {
-            let up = self.0[self.0[v as usize] as usize];
-            self.0[v as usize] = up;
-            v = up;
-        }
-        v
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.0[ra.max(rb) as usize] = ra.min(rb);
-        }
-    }
-}
-
-/// The pieces of `quads` (vertices joined through quads).
-fn pieces(quads: &QuadMesh) -> Pieces {
-    let mut p = Pieces((0..quads.positions.len() as u32).collect());
+/// The pieces of `quads`: sets of vertices joined through quads.
+fn pieces(quads: &QuadMesh) -> UnionFind {
+    let mut p = UnionFind::new(quads.positions.len());
     for q in &quads.quads {
         for &v in &q[1..] {
             p.union(q[0], v);
