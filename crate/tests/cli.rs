@@ -82,6 +82,11 @@ fn quads_writes_a_quad_obj_and_its_report() {
 
     let bad = Command::new(env!("CARGO_BIN_EXE_conemap")).arg("quads").arg(spot).arg("-o").arg(&obj).args(["--quads", "10", "--quad-size", "0.1"]).output().unwrap();
     assert_eq!(bad.status.code(), Some(2));
+    // A maximum edge length far below the mesh's size is refused up front,
+    // not refined until memory runs out.
+    let tiny = Command::new(env!("CARGO_BIN_EXE_conemap")).arg("quads").arg(spot).arg("-o").arg(&obj).args(["--max-edge", "0.01%"]).output().unwrap();
+    assert_eq!(tiny.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&tiny.stderr).contains("would split the mesh into about"), "{}", String::from_utf8_lossy(&tiny.stderr));
     std::fs::remove_dir_all(&dir).ok();
 }
 

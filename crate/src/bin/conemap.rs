@@ -405,36 +405,24 @@ fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
 /// Both stages' settings: [`cone_options`] and `--max-edge L|X%` (split
 /// edges longer than L model units, or X % of `mesh`'s bounding-box
 /// diagonal, before the cones); `default_max_edge` when the flag is absent.
-fn solve_options(
-    args: &Args,
-    mesh: &TriMesh,
-    default_max_edge: Option<f64>,
-) -> Result<conemap::pipeline::SolveOptions, Failure> {
-    let mut options = conemap::pipeline::SolveOptions {
-        cones: cone_options(args)?,
-        ..Default::default()
-    };
+fn solve_options(args: &Args, mesh: &TriMesh, default_max_edge: Option<f64>) -> Result<conemap::pipeline::SolveOptions, Failure> {
+    let mut options = conemap::pipeline::SolveOptions { cones: cone_options(args)?, ..Default::default() };
     options.refine.max_edge_length = match args.value("--max-edge") {
         None => default_max_edge,
         Some("none") => None,
         Some(v) => {
-            let bad = || {
-                usage(&format!("--max-edge expects a positive length, a percentage (\"2%\") or none, got \"{v}\""))
-            };
+            let bad = || usage(&format!("--max-edge expects a positive length, a percentage (\"2%\") or none, got \"{v}\""));
             let (number, fraction) = match v.strip_suffix('%') {
                 Some(p) => (p, true),
                 None => (v, false),
             };
-            let x = number
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite() && *x > 0.0)
-                .ok_or_else(bad)?;
-            Some(if fraction {
-                x / 100.0 * mesh.bounding_diagonal()
-            } else {
-                x
-            })
+            let x = number.parse::<f64>().ok().filter(|x| x.is_finite() && *x > 0.0).ok_or_else(bad)?;
+            let length = if fraction { x / 100.0 * mesh.bounding_diagonal() } else { x };
+            let (faces, most) = (conemap::features::faces_for_length(mesh, length), conemap::features::MAX_REFINED_FACES);
+            if faces > most as f64 {
+                return Err(usage(&format!("--max-edge {v} would split the mesh into about {faces:.0} triangles (at most {most}): give a longer length")));
+            }
+            Some(length)
         }
     };
     Ok(options)

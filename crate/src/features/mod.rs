@@ -15,7 +15,10 @@ mod refine;
 
 pub use cut::{boundary_turning, cut_open, CutMesh};
 pub use detect::{detect_sharp, MinLength, SharpDetection, SharpOptions, SharpStats};
-pub use refine::{refine_for_features, refine_for_features_on, split_around, split_flipped, split_long_edges, RefineCounts, Refined};
+pub use refine::{
+    faces_for_length, refine_for_features, refine_for_features_on, split_around, split_flipped, split_long_edges, RefineCounts, Refined,
+    MAX_REFINED_FACES,
+};
 
 use crate::mesh::TriMesh;
 use locate::VertexLocator;

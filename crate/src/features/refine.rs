@@ -150,6 +150,18 @@ pub fn split_flipped(mesh: &TriMesh, features: &FeatureSet, current: Option<Refi
     plan.apply(m, f, current.as_ref())
 }
 
+/// [`split_long_edges`] stops splitting once the mesh has more faces than
+/// this, however long its edges still are (a length far below the mesh's
+/// size would otherwise fill memory): use [`faces_for_length`] to check a
+/// length first.
+pub const MAX_REFINED_FACES: usize = 1_000_000;
+
+/// About how many faces `mesh` has once split down to edges of `length`:
+/// its area over that of an equilateral triangle of that edge.
+pub fn faces_for_length(mesh: &TriMesh, length: f64) -> f64 {
+    mesh.face_areas().iter().sum::<f64>() / (3f64.sqrt() / 4.0 * length * length)
+}
+
 /// Passes of [`split_long_edges`]: each halves the longest edge of every
 /// face it may; 48 passes take an edge down by far more than any mesh
 /// needs (a face may wait for a neighbour's split).
@@ -161,7 +173,7 @@ const MAX_LENGTH_PASSES: usize = 48;
 /// make them Delaunay ([`flip_coplanar`]), so that a flat region's long thin
 /// triangles give well-shaped small ones instead of thinner strips. The
 /// surface, its features and its boundary are unchanged. `current` when no
-/// edge is that long.
+/// edge is that long; splitting stops past [`MAX_REFINED_FACES`] faces.
 pub fn split_long_edges(mesh: &TriMesh, features: &FeatureSet, mut current: Option<Refined>, max_length: f64) -> Option<Refined> {
     if long_edges(current.as_ref().map_or(mesh, |r| &r.mesh), max_length).is_empty() {
         return current;
@@ -170,7 +182,7 @@ pub fn split_long_edges(mesh: &TriMesh, features: &FeatureSet, mut current: Opti
     for _ in 0..MAX_LENGTH_PASSES {
         let (m, f) = current.as_ref().map_or((mesh, features), |r| (&r.mesh, &r.features));
         let long = long_edges(m, max_length);
-        if long.is_empty() {
+        if long.is_empty() || m.n_faces() > MAX_REFINED_FACES {
             break;
         }
         let mut plan = Splits::new(m);
@@ -520,5 +532,17 @@ mod tests {
             assert!(on, "vertex {v} is off the input");
         }
         assert!(split_long_edges(&r.mesh, &r.features, None, length).is_none());
+    }
+
+    /// A length far below the mesh's size stops at [`MAX_REFINED_FACES`]
+    /// faces instead of filling memory; [`faces_for_length`] tells it first.
+    #[test]
+    fn splitting_stops_past_the_face_limit() {
+        let m = TriMesh::from_raw(&crate::mesh::shapes::cad_cylinder(16, 3.0)).unwrap();
+        let f = FeatureSet::none(&m);
+        let length = 1e-4;
+        assert!(faces_for_length(&m, length) > 100.0 * MAX_REFINED_FACES as f64);
+        let r = split_long_edges(&m, &f, None, length).expect("the cylinder has long edges");
+        assert!(r.mesh.n_faces() > MAX_REFINED_FACES && r.mesh.n_faces() < 4 * MAX_REFINED_FACES, "{} faces", r.mesh.n_faces());
     }
 }
