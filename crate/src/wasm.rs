@@ -78,11 +78,12 @@ pub struct MeshSession {
 /// re-runs only quantization and extraction.
 struct GridStage {
     /// The last solve's map; for a mesh whose edges are longer than a quad
-    /// mesh wants ([`pipeline::quads_refine`]), replaced on the first quads
+    /// mesh wants ([`pipeline::long_edges_refine`]), replaced on the first quads
     /// request by the map solved on its refinement.
     solution: Solution<'static>,
     quantizer: Option<Quantizer>,
-    /// The solve's features and settings, to solve again on the refinement.
+    /// The solve's features and settings as solved (with the low-poly
+    /// fallback's maximum edge length, if it took one), to solve again on the refinement.
     features: FeatureSet,
     options: SolveOptions,
 }
@@ -303,6 +304,8 @@ impl MeshSession {
         let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
         let sol = placed.parametrize(mesh, &features, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
+        // As solved: a low-poly fallback's edge length is not asked again.
+        let options = SolveOptions { refine: sol.refine_options, ..options };
         self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None, features, options });
         Ok(result)
     }
@@ -311,7 +314,7 @@ impl MeshSession {
     /// and the quad mesh traced on it (a [`QuadsResult`]); re-runs only
     /// quantization and extraction, except on the first call for a mesh
     /// with edges longer than a quad mesh wants: the map is then solved
-    /// again on its refinement (`pipeline::quads_refine`; where that solve
+    /// again on its refinement (`pipeline::long_edges_refine`; where that solve
     /// fails, the last solve's map is used). Throws when nothing was solved
     /// yet, or with the quantization error (a free boundary, say).
     pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
@@ -319,7 +322,7 @@ impl MeshSession {
         let (Some(input), Some(grid)) = (self.mesh.as_ref(), self.grid.as_mut()) else {
             return Err(JsError::new("solve the map before asking for quads").into());
         };
-        if let Some(refine) = pipeline::quads_refine(input, &grid.options.refine) {
+        if let Some(refine) = pipeline::long_edges_refine(input, &grid.options.refine) {
             let options = SolveOptions { refine, ..grid.options };
             match pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)) {
                 Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, features: grid.features.clone(), options },
@@ -598,7 +601,7 @@ struct QuadsResult<'a> {
     /// Places the extractor had to repair.
     defects: usize,
     /// The mesh the map was solved on: its faces, the vertices inserted into
-    /// the input, and why ([`pipeline::quads_refine`] may have refined it).
+    /// the input, and why ([`pipeline::long_edges_refine`] may have refined it).
     solved_faces: usize,
     inserted_vertices: usize,
     refinement: &'a RefineCounts,

@@ -7,7 +7,7 @@
 
 use conemap::features::FeatureSet;
 use conemap::mesh::TriMesh;
-use conemap::pipeline::{solve, Solution, SolveOptions, ALIGNED_TOLERANCE};
+use conemap::pipeline::{solve, RefineOptions, Solution, SolveOptions, ALIGNED_TOLERANCE};
 
 mod common;
 use common::shared_mesh as load;
@@ -236,15 +236,27 @@ mod random_features {
 
 /// A low-poly CAD export (a cylinder of 48 segments: its caps fans of long,
 /// thin triangles, 188 faces) has too few vertices for a map without folds
-/// even after the local refinements; the mesh is then refined everywhere
-/// and solved again, and the result says what was inserted.
+/// even after the local refinements; it is then solved again from the input
+/// with its long edges split ([`pipeline::long_edges_refine`]), and the
+/// result says what was inserted and to what length.
 #[test]
-fn a_low_poly_cad_cylinder_solves_after_refining_everywhere() {
+fn a_low_poly_cad_cylinder_solves_after_splitting_its_long_edges() {
     let raw = conemap::mesh::shapes::cad_cylinder(48, 2.0);
     let mesh = TriMesh::from_raw(&raw).unwrap();
     assert!(mesh.n_faces() < conemap::pipeline::LOW_POLY_FACES);
     let features = FeatureSet::sharp_edges(&mesh, 60.0);
     assert_eq!(features.len(), 96);
     let solution = check("low-poly cylinder", &mesh, &features);
-    assert!(solution.mesh.n_faces() > 2 * mesh.n_faces(), "refined to {} faces", solution.mesh.n_faces());
+    let length = conemap::pipeline::QUAD_MAX_EDGE * mesh.bounding_diagonal();
+    assert_eq!(solution.refine_options.max_edge_length, Some(length));
+    assert!(solution.refinement.long_edges > 0, "{:?}", solution.refinement);
+    assert!((0..solution.mesh.n_edges() as u32).all(|e| solution.mesh.edge_length(e) <= length));
+    // The fallback after it (the longest edge of every face split, until the
+    // mesh is no longer low-poly), reached when a maximum length was asked.
+    let asked = RefineOptions { max_edge_length: Some(10.0 * mesh.bounding_diagonal()), ..RefineOptions::default() };
+    let everywhere = solve(&mesh, &features, &SolveOptions { refine: asked, ..SolveOptions::default() }, &mut |_| {}).unwrap();
+    assert_eq!(everywhere.refinement.long_edges, 0);
+    let (split, bisected) = (solution.param.metrics.distortion, everywhere.param.metrics.distortion);
+    eprintln!("distortion {split} on {} faces, {bisected} on {}", solution.mesh.n_faces(), everywhere.mesh.n_faces());
+    assert!(split < 0.5 * bisected, "distortion {split} with long edges split, {bisected} bisected everywhere");
 }

@@ -73,3 +73,53 @@ pub fn cad_cylinder(n_around: usize, height: f64) -> RawMesh {
     }
     RawMesh { positions, triangles }
 }
+
+/// The closed surface of an `nx` × `ny` × `nz` block of unit cubes with the
+/// columns `holes` (cube `(i, j)`, all `k`) removed: a block with through
+/// holes of genus `holes.len()` (when no two touch each other or the sides),
+/// every cube face two triangles, as a voxel or CAD export gives it.
+pub fn voxel_block(nx: usize, ny: usize, nz: usize, holes: &[(usize, usize)]) -> RawMesh {
+    let filled = |c: [i64; 3]| {
+        let inside = c[0] >= 0 && c[1] >= 0 && c[2] >= 0 && c[0] < nx as i64 && c[1] < ny as i64 && c[2] < nz as i64;
+        inside && !holes.contains(&(c[0] as usize, c[1] as usize))
+    };
+    let mut index = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let mut vertex = |p: [i64; 3]| {
+        *index.entry(p).or_insert_with(|| {
+            positions.push(p.map(|c| c as f64));
+            (positions.len() - 1) as u32
+        })
+    };
+    let mut triangles = Vec::new();
+    for (i, j, k) in (0..nx).flat_map(|i| (0..ny).flat_map(move |j| (0..nz).map(move |k| (i, j, k)))) {
+        let cube = [i as i64, j as i64, k as i64];
+        if !filled(cube) {
+            continue;
+        }
+        for axis in 0..3 {
+            for side in [-1i64, 1] {
+                let mut next = cube;
+                next[axis] += side;
+                if filled(next) {
+                    continue;
+                }
+                // The face's corners counter-clockwise seen from outside.
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let mut origin = cube;
+                origin[axis] += (side + 1) / 2;
+                let mut corners = [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(du, dv)| {
+                    let mut p = origin;
+                    p[u] += du;
+                    p[v] += dv;
+                    vertex(p)
+                });
+                if side < 0 {
+                    corners.reverse();
+                }
+                triangles.extend([[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]]);
+            }
+        }
+    }
+    RawMesh { positions, triangles }
+}

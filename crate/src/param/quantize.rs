@@ -81,6 +81,10 @@ const NEAR_INTEGER: f64 = 1e-6;
 /// Times a batch is solved again with its conflicting forms moved first.
 const MAX_REORDERS: usize = 8;
 
+/// Rounded integers moved, at most per batch, so that forms the others
+/// determine come out integers ([`Quantizer::restore_parity`]).
+const PARITY_MOVES: usize = 64;
+
 /// Share of its seamless-map UV area below which a triangle counts as
 /// collapsed (squeezed onto a grid line: the exact snapping of the integers
 /// afterwards makes it degenerate).
@@ -638,6 +642,7 @@ impl Quantizer {
                     batch.splice(0..0, conflicting);
                 };
                 let mut solved = solved;
+                self.restore_parity(&mut solved, &dependent, &mut values, x0, targets)?;
                 separation_moves += self.separate(&mut solved, &mut values, x0, targets)?;
                 x = solved.x.clone();
                 // A candidate the batch's other forms already determine takes the
@@ -868,6 +873,50 @@ impl Quantizer {
             self.take_determined_values(values, &system.x);
             seen.insert(values.to_vec());
             violated = after;
+            moves += 1;
+        }
+        Ok(moves)
+    }
+
+    /// Moves rounded integers by one until every form in `dependent` (those
+    /// the rounded forms determine) is an integer in `system.x`, and returns
+    /// the moves. Transitions of 90° are determined only up to a sublattice:
+    /// a cone's position `c` across a seam of rotation `R` gives `(I - R) c`,
+    /// of determinant 2, so a form may be determined at half an integer when
+    /// the integers it depends on were rounded independently (a genus-2 block
+    /// without features at 3 000 cells: 18 translations at n + 1/2). The form's
+    /// dependence on every rounded row is one adjoint solve
+    /// ([`RoundedSystem::sensitivity`]); of the rounded integers that a step
+    /// of one makes it integral, the one whose step costs least (its new
+    /// value nearest the seamless map's) moves, without a new factorization.
+    fn restore_parity(
+        &self,
+        system: &mut RoundedSystem,
+        dependent: &[usize],
+        values: &mut [Option<i64>],
+        x0: &[f64],
+        targets: &[[[f64; 2]; 2]],
+    ) -> Result<usize, QuantizeError> {
+        let mut moves = 0;
+        while moves < PARITY_MOVES {
+            let off = |i: &&usize| distance_to_integer(self.forms[**i].value(&system.x)) > NEAR_INTEGER;
+            let Some(&i) = dependent.iter().find(off) else { break };
+            let value = self.forms[i].value(&system.x);
+            let gain = system.sensitivity(&self.forms[i].row)?;
+            let best = system
+                .form_rows
+                .iter()
+                .flat_map(|&(form, row)| [(form, row, 1), (form, row, -1)])
+                .filter(|&(_, row, step)| distance_to_integer(value + gain[row] * step as f64) < NEAR_INTEGER)
+                .filter_map(|(form, row, step)| {
+                    let v = values[form]?;
+                    Some((((v + step) as f64 - self.forms[form].value(x0)).abs(), form, row, step))
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let Some((_, form, row, step)) = best else { break };
+            values[form] = values[form].map(|v| v + step);
+            system.b[row] += step as f64;
+            system.x = system.resolve(self, targets)?;
             moves += 1;
         }
         Ok(moves)
