@@ -6,7 +6,7 @@
 use conemap::cones::{self, BoundaryMode, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;
 use conemap::mesh::{analyze_located, Located, RawMesh, TriMesh};
-use conemap::param::quantize::{GridSize, IntegerGridMap, QuantizeReport};
+use conemap::param::quantize::{GridSize, IntegerGridMap, QuantizeOptions, QuantizeReport};
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -620,7 +620,7 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     times.cones = solution.refine_seconds + solution.placement.timings.total;
     times.param = clock.lap() - times.cones;
     let grid_map = match grid {
-        Some(size) => Some(quantize(file, &solution, size)?),
+        Some(size) => Some(quantize(file, &solution, size, &QuantizeOptions { retry_wound: true })?),
         None => None,
     };
     times.quantize = clock.lap();
@@ -700,9 +700,9 @@ fn grid_option(args: &Args, flag: &str) -> Result<Option<GridSize>, Failure> {
 }
 
 /// The integer-grid map of `solution` for grid size `size`.
-fn quantize(file: &str, solution: &conemap::pipeline::Solution, size: GridSize) -> Result<IntegerGridMap, Failure> {
+fn quantize(file: &str, solution: &conemap::pipeline::Solution, size: GridSize, options: &QuantizeOptions) -> Result<IntegerGridMap, Failure> {
     let quantizer = solution.quantizer().map_err(|e| Failure(format!("{file}: {e}"), 1))?;
-    quantizer.quantize(&solution.mesh, size, &mut |_, _| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))
+    quantizer.quantize_with(&solution.mesh, size, options, &mut |_, _| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))
 }
 
 /// The summary of a quantization.
@@ -713,6 +713,12 @@ fn print_quantization(r: &QuantizeReport) {
     );
     if r.conflicts > 0 {
         println!("  warning: {} integers could not be met (determined by others at a non-integer value)", r.conflicts);
+    }
+    if r.flipped > 0 || r.wound_vertices > 0 {
+        println!(
+            "  warning: the integer-grid map folds ({} flipped triangles, {} vertices it winds around); a nearby --quads or --grid often rounds cleanly",
+            r.flipped, r.wound_vertices
+        );
     }
 }
 

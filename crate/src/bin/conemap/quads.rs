@@ -3,7 +3,7 @@
 //! as two triangles plus a LINES primitive of the quad edges).
 
 use super::{check_writable, cone_options, grid_option, load_features, quantize, read_input, solve_mesh, solve_options, usage, Args, Failure};
-use conemap::param::quantize::GridSize;
+use conemap::param::quantize::{GridSize, QuantizeOptions};
 use conemap::quads::{check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
 use std::path::Path;
 
@@ -31,7 +31,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let options = solve_options(args, &input.mesh, max_edge)?;
     let solution = solve_mesh(args, file, &input.mesh, &features, &options)?;
     let solve = clock.lap();
-    let map = quantize(file, &solution, grid)?;
+    let map = quantize(file, &solution, grid, &QuantizeOptions::default())?;
     let quantize_seconds = clock.lap();
     let quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let extract = clock.lap();
