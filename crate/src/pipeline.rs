@@ -575,26 +575,44 @@ impl Placed {
     ) -> Result<Solution<'a>, SolveError> {
         let mut options = self.options;
         let (initial, refine_seconds) = (self.refined.clone(), self.refine_seconds);
-        let mut best = self.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p)))?;
         // With features, the cone moves' proxy (the conformal scale's norm,
         // section 5.3) can disagree with the map: fewer cones lower it while
         // the isolines along the features shear the map more (spot >40°:
         // 75 -> 36 cones, distortion 0.14 -> 0.25; bunny >60° 0.135 -> 0.172;
         // a plate with five holes 0.125 -> 0.243). The placement without
-        // moves is parametrized too, and the map with fewer flipped
-        // triangles, then lower distortion, kept.
-        if !features.is_empty() && options.cones.optimize_locations {
-            let unmoved = SolveOptions { cones: ConeOptions { optimize_locations: false, ..options.cones }, ..options };
-            let attempt = ConeStage::with_refinement(mesh, features, &unmoved, initial.clone(), 0, refine_seconds, now_seconds())
-                .place(mesh, features, &mut |p| progress(SolveProgress::Cones(p)))
-                .and_then(|placed| placed.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p))));
-            let key = |s: &Solution| (s.param.metrics.flipped, s.param.metrics.distortion);
-            if let Ok(other) = attempt {
-                if key(&other) < key(&best) {
-                    (best, options) = (other, unmoved);
-                }
+        // moves is parametrized too (natively on a second thread), and the
+        // map with fewer flipped triangles, then lower distortion, kept.
+        let unmoved = SolveOptions { cones: ConeOptions { optimize_locations: false, ..options.cones }, ..options };
+        let compare = !features.is_empty() && options.cones.optimize_locations;
+        let other = |progress: &mut dyn FnMut(SolveProgress)| -> Option<Solution<'a>> {
+            let stage = ConeStage::with_refinement(mesh, features, &unmoved, initial.clone(), 0, refine_seconds, now_seconds());
+            let placed = stage.place(mesh, features, &mut |p| progress(SolveProgress::Cones(p))).ok()?;
+            placed.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p))).ok()
+        };
+        #[cfg(not(target_arch = "wasm32"))]
+        let (first, other) = std::thread::scope(|scope| {
+            let helper = compare.then(|| scope.spawn(|| other(&mut |_| {})));
+            let first = self.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p)));
+            (first, helper.and_then(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))))
+        });
+        #[cfg(target_arch = "wasm32")]
+        let (first, other) = {
+            let first = self.parametrize_once(mesh, features, &mut |p| progress(SolveProgress::Param(p)));
+            (first, if compare { other(progress) } else { None })
+        };
+        let key = |s: &Solution| (s.param.metrics.flipped, s.param.metrics.distortion);
+        let mut best = match (first, other) {
+            (Ok(first), Some(other)) if key(&other) < key(&first) => {
+                options = unmoved;
+                other
             }
-        }
+            (Ok(first), _) => first,
+            (Err(_), Some(other)) => {
+                options = unmoved;
+                other
+            }
+            (Err(e), None) => return Err(e),
+        };
         for _ in 0..options.refine.max_flip_refinements {
             let mut flipped = best.flipped_faces();
             if flipped.is_empty() {
