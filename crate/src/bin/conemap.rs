@@ -72,9 +72,12 @@ commands:
                        box diagonal), flipping edges between coplanar
                        triangles to keep them well shaped: more vertices
                        for the cones and the map on a low-poly mesh (a CAD
-                       export); default none (quads: 5%). --no-moves: skip
-                       the cone-location optimization. --json prints one
-                       JSON object.
+                       export); default none (quads: 5%; solve splits to
+                       5% only where the map of a low-poly mesh folds).
+                       --no-moves: skip the cone-location optimization
+                       (with features, solve and quads otherwise also map
+                       the placement without moves and keep the better
+                       map). --json prints one JSON object.
                        On a terminal, the stage and its progress (rounding
                        round and integers left, cone-move pass, ARAP and
                        injective iterations) show on standard error while
