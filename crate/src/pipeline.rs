@@ -643,9 +643,11 @@ impl Placed {
         // decides in parallel what the paper's rule decides one batch at a
         // time, so where that placement folds, place once more the paper's
         // way. (The retry's own fallback then covers the last.)
+        // (`best` no longer changes: every fallback below returns its own solution.)
         let m = &best.param.metrics;
+        let folds = m.flipped > 0 || m.wound_vertices > 0;
         let coarse = mesh.n_vertices() > options.cones.coarse_vertices;
-        if (m.flipped > 0 || m.wound_vertices > 0) && (coarse || options.cones.rounding == RoundingRule::PerCluster) {
+        if folds && (coarse || options.cones.rounding == RoundingRule::PerCluster) {
             let mut retry = options;
             if coarse {
                 retry.cones.coarse_vertices = usize::MAX;
@@ -664,16 +666,12 @@ impl Placed {
         // plate with five holes failed after 115 s, 0.37 s this way); where
         // that still folds, split the longest edge of every face and solve
         // again, until the mesh is no longer low-poly.
-        let m = &best.param.metrics;
-        if (m.flipped > 0 || m.wound_vertices > 0) && best.mesh.n_faces() < LOW_POLY_FACES {
+        if folds && best.mesh.n_faces() < LOW_POLY_FACES {
             if let Some(refine) = long_edges_refine(mesh, &options.refine) {
                 if let Ok(solution) = solve(mesh, features, &SolveOptions { refine, ..options }, progress) {
                     return Ok(solution);
                 }
             }
-        }
-        let m = &best.param.metrics;
-        if (m.flipped > 0 || m.wound_vertices > 0) && best.mesh.n_faces() < LOW_POLY_FACES {
             let mut clock = Stopwatch::start();
             let all: Vec<u32> = (0..best.mesh.n_faces() as u32).collect();
             let refined = split_flipped(mesh, features, best.refinement_of_input(), &all);
@@ -681,8 +679,7 @@ impl Placed {
                 return Ok(solution);
             }
         }
-        let m = &best.param.metrics;
-        if m.flipped > 0 || m.wound_vertices > 0 {
+        if folds {
             let cause = SolveCause::Folded {
                 flipped: m.flipped,
                 wound: m.wound_vertices,

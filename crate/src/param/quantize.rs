@@ -903,8 +903,8 @@ impl Quantizer {
     }
 
     /// Moves rounded integers by one until every form in `dependent` (those
-    /// the rounded forms determine) is an integer in `system.x`, and returns
-    /// the moves. Transitions of 90° are determined only up to a sublattice:
+    /// the rounded forms determine) is an integer in `system.x` (at most
+    /// [`PARITY_MOVES`]). Transitions of 90° are determined only up to a sublattice:
     /// a cone's position `c` across a seam of rotation `R` gives `(I - R) c`,
     /// of determinant 2, so a form may be determined at half an integer when
     /// the integers it depends on were rounded independently (a genus-2 block
@@ -920,9 +920,8 @@ impl Quantizer {
         values: &mut [Option<i64>],
         x0: &[f64],
         targets: &[[[f64; 2]; 2]],
-    ) -> Result<usize, QuantizeError> {
-        let mut moves = 0;
-        while moves < PARITY_MOVES {
+    ) -> Result<(), QuantizeError> {
+        for _ in 0..PARITY_MOVES {
             let off = |i: &&usize| distance_to_integer(self.forms[**i].value(&system.x)) > NEAR_INTEGER;
             let Some(&i) = dependent.iter().find(off) else { break };
             let value = self.forms[i].value(&system.x);
@@ -941,9 +940,8 @@ impl Quantizer {
             values[form] = values[form].map(|v| v + step);
             system.b[row] += step as f64;
             system.x = system.resolve(self, targets)?;
-            moves += 1;
         }
-        Ok(moves)
+        Ok(())
     }
 
     /// `full` scaled by the share of the full budgets this mesh gets
