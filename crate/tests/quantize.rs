@@ -23,6 +23,14 @@ fn off_integer(values: impl IntoIterator<Item = f64>) -> f64 {
 /// and of singular vertices (UV angle sum off 2 pi, away from flips) off
 /// an integer point.
 fn check_integer_grid(name: &str, mesh: &TriMesh, features: &FeatureSet, uv: &[[f64; 2]]) -> (usize, usize) {
+    let (flipped, off_grid, cones) = check_integer_grid_counting_cones(name, mesh, features, uv);
+    assert!(cones > 0, "{name}: no cone found");
+    (flipped, off_grid)
+}
+
+/// [`check_integer_grid`], for a map that may have no interior cone: also
+/// returns the number of singular interior vertices.
+fn check_integer_grid_counting_cones(name: &str, mesh: &TriMesh, features: &FeatureSet, uv: &[[f64; 2]]) -> (usize, usize, usize) {
     let rotate = |k: usize, p: [f64; 2]| match k % 4 {
         0 => p,
         1 => [-p[1], p[0]],
@@ -86,7 +94,6 @@ fn check_integer_grid(name: &str, mesh: &TriMesh, features: &FeatureSet, uv: &[[
             }
         }
     }
-    assert!(cones > 0, "{name}: no cone found");
 
     // Features and boundary on integer isolines.
     let mut worst_isoline = 0.0f64;
@@ -104,7 +111,7 @@ fn check_integer_grid(name: &str, mesh: &TriMesh, features: &FeatureSet, uv: &[[
         }
     }
     assert!(worst_isoline < 1e-9, "{name}: feature edge off an integer isoline by {worst_isoline:.2e}");
-    (flipped.len(), off_grid)
+    (flipped.len(), off_grid, cones)
 }
 
 /// Quantizes `name` and checks the integer-grid properties; returns the
@@ -346,7 +353,7 @@ fn cells_the_map_winds_around_are_closed_with_quads() {
     let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
     assert!(!quads.defects.is_empty());
     for d in &quads.defects {
-        assert!(d.what.contains("closed") && !d.what.contains("skipped"), "{d:?}");
+        assert!(d.what.contains("winds around") && !d.what.contains("skipped"), "{d:?}");
     }
     let r = check_quads(&solution.mesh, &quads, &CheckOptions::default());
     assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (2, 0, 1), "{r:?}");
@@ -372,30 +379,30 @@ fn quantizer_reruns_for_another_size() {
 }
 
 
-/// With scattered features (the cow at `--sharp 90`, 2 500 quads) the
+/// With scattered features (spot at `--sharp 40`, 1 500 quads) the
 /// rounding at the asked grid length folds the map; with a quad count the
 /// quantizer also rounds at grid lengths a few percent off and keeps the
-/// map with fewer flips, while an explicit length is kept exactly. The
-/// flips left are holes in the traced quads, and the extractor fills them:
-/// the quad mesh is closed with the input's Euler characteristic.
+/// map with fewer flips, while an explicit length is kept exactly. What is
+/// left (cells the map winds around) the extractor closes: the quad mesh
+/// is closed with the input's Euler characteristic.
 #[test]
 fn nearby_grid_sizes_mend_a_folding_rounding() {
     use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
-    let input = load("cow.obj");
-    let features = FeatureSet::sharp_edges(&input, 90.0);
+    let input = load("spot.obj");
+    let features = FeatureSet::sharp_edges(&input, 40.0);
     let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
     let quantizer = solution.quantizer().unwrap();
-    let s = quantizer.grid_length(GridSize::Quads(2500)).unwrap();
+    let s = quantizer.grid_length(GridSize::Quads(1500)).unwrap();
     let exact = quantizer.quantize(&solution.mesh, GridSize::Length(s), &mut |_, _| {}).unwrap();
     assert_eq!(exact.report.grid_size, s);
     assert!(exact.report.flipped > 0, "the case this tests is gone: {:?}", exact.report);
-    let count = quantizer.quantize(&solution.mesh, GridSize::Quads(2500), &mut |_, _| {}).unwrap();
+    let count = quantizer.quantize(&solution.mesh, GridSize::Quads(1500), &mut |_, _| {}).unwrap();
     let r = &count.report;
     assert!(r.flipped < exact.report.flipped, "{} flipped, {} at the asked length", r.flipped, exact.report.flipped);
     assert!(r.grid_size != s && (r.grid_size / s - 1.0).abs() <= 0.031, "grid {} against {s}", r.grid_size);
     assert_eq!(r.conflicts, 0);
     let quads = extract_quads(&solution.mesh, &count.uv, &ExtractOptions::default()).unwrap();
-    assert!(quads.defects.iter().any(|d| d.what.contains("closed with")), "{:?}", quads.defects);
+    assert!(!quads.defects.is_empty() && quads.defects.iter().all(|d| d.what.contains("closed")), "{:?}", quads.defects);
     let q = check_quads(&solution.mesh, &quads, &CheckOptions::default());
     assert_eq!((q.euler_characteristic, q.boundary_loops, q.components), (2, 0, 1), "{q:?}");
     assert_eq!((q.non_manifold_edges, q.unreferenced_vertices), (0, 0), "{q:?}");
@@ -446,3 +453,32 @@ fn a_low_poly_cad_cylinder_is_refined_for_quads() {
     assert_eq!((uncornered.quads, uncornered.euler_characteristic), (after.quads, 2));
 }
 
+
+/// A feature curve that ends inside the surface is an isoline running on
+/// through its end, so only its constant is an integer: with the end's
+/// other coordinate an integer too, a curve shorter than a cell had its
+/// two ends squeezed onto one grid point or stretched a cell apart (on this
+/// sheet with creases of one and two edges, a fifth of a cell and less, the
+/// distortion rose from 0.018 to 0.068 at 300 quads; it is 0.028 now).
+#[test]
+fn feature_curves_that_end_inside_a_cell_are_not_stretched_to_it() {
+    let n = 96;
+    let raw = conemap::mesh::shapes::grid(n, n, |x, y| [x, y, 0.15 * (3.0 * x).sin() * (2.0 * y).cos()]);
+    let sheet = TriMesh::from_raw(&raw).unwrap();
+    let id = |i: usize, j: usize| j * (n + 1) + i;
+    let mut creases = Vec::new();
+    for (i, j, di, dj, length) in [(21, 25, 1, 0, 2), (61, 41, 0, 1, 1), (41, 69, 1, 0, 1), (73, 73, 0, 1, 2), (29, 57, 1, 0, 1), (50, 50, 1, 1, 1)] {
+        for k in 0..length {
+            let (a, b) = (id(i + di * k, j + dj * k), id(i + di * (k + 1), j + dj * (k + 1)));
+            creases.push([raw.positions[a], raw.positions[b]]);
+        }
+    }
+    let features = FeatureSet::from_positions(&sheet, &creases).unwrap();
+    assert_eq!(features.len(), 8);
+    let solution = solve(&sheet, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(300), &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert_eq!((r.conflicts, r.flipped, r.wound_vertices), (0, 0, 0), "{r:?}");
+    assert!(r.distortion_after < 2.0 * r.distortion_before, "{r:?}");
+    assert_eq!(check_integer_grid_counting_cones("creased sheet", &solution.mesh, &solution.features, &map.uv), (0, 0, 0));
+}

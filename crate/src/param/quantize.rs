@@ -3,7 +3,10 @@
 //! (model units) the map is scaled to grid units (`uv / s`), and then
 //! - every singular point (cone, and any boundary or feature corner whose UV
 //!   angle is not straight) lands on an integer point,
-//! - every feature and boundary isoline on an integer `u` or `v`,
+//! - every feature and boundary isoline on an integer `u` or `v` (the end
+//!   of a feature curve inside the surface, where the isoline runs straight
+//!   on, is no singular point: on a curve shorter than a cell it stays off
+//!   the grid points, [`CurveEnd`]),
 //! - every seam transition's translation becomes an integer vector,
 //!
 //! while the seam rows of (B.2) and the isolines keep holding exactly. The
@@ -58,11 +61,12 @@ use super::seamless::{
     closest_rotation, curve_rotation, curve_wedge_pairs, elements, factored, seam_rows,
     stiffness_triplets, unknowns, RowSet,
 };
-use super::separation::{self, Separation};
+use super::separation::{Separation, Separations};
 use super::untangle::{untangle, UntangleOptions};
 use super::{ParamError, Parametrization};
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
+use crate::features::CutMesh;
 use crate::linalg::{
     constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, Triplet,
 };
@@ -95,6 +99,14 @@ const WOUND_WEIGHT: usize = 16;
 
 /// Integer moves tried against flipped or collapsed triangles, at most.
 const UNCOLLAPSE_TRIALS: usize = 40;
+
+/// Radius (grid units) within which an integer of the seamless map side by
+/// side with a singular point must stay a grid line from it ([`Separations`]).
+const SEPARATION_RADIUS: f64 = 1.0;
+
+/// Feature curves shorter than this many grid cells keep their inner ends
+/// off the grid points ([`CurveEnd`]).
+const CURVE_END_CELLS: f64 = 1.0;
 
 /// Re-solves spent restoring separations after a batch, at most.
 const SEPARATION_TRIALS: usize = 200;
@@ -236,6 +248,17 @@ enum FormKind {
     Translation,
 }
 
+/// The end of a feature curve inside the mesh: the form of its coordinate
+/// along the curve, and the curve's length (model units). Where the curve
+/// is shorter than [`CURVE_END_CELLS`] cells the form is left free: only
+/// the isoline is an integer (its two ends on grid points would squeeze
+/// it to a point or stretch it to a cell).
+#[derive(Clone, Copy, Debug)]
+struct CurveEnd {
+    form: usize,
+    length: f64,
+}
+
 /// A linear form of the unknowns that must take an integer value.
 #[derive(Clone, Debug)]
 struct Form {
@@ -270,6 +293,10 @@ pub struct QuantizeReport {
     /// (each one a collapse).
     pub separations: usize,
     pub separations_violated: usize,
+    /// Ends of feature curves inside the mesh, and those left off the grid
+    /// points (their curve shorter than a cell).
+    pub curve_ends: usize,
+    pub free_curve_ends: usize,
     /// Integers moved by one to undo a collapse ([`Quantizer::uncollapse`]).
     pub moved_integers: usize,
     /// ARAP iterations kept after the rounding.
@@ -316,10 +343,11 @@ pub struct Quantizer {
     /// one coordinate each (rounding all three to one integer collapses the
     /// triangle onto a grid line).
     triples: Vec<Vec<[usize; 3]>>,
-    /// Pairs of forms that must stay a grid line apart, and per form the
-    /// indices of those it is in.
-    separations: Vec<Separation>,
-    separations_of: Vec<Vec<usize>>,
+    /// Per unknown: whether the integer-grid map makes it an integer (the
+    /// unknowns [`Separations`] keep apart).
+    integral: Vec<bool>,
+    /// The ends of feature curves inside the mesh ([`curve_ends`]).
+    curve_ends: Vec<CurveEnd>,
     /// Per unknown: the form that is that unknown alone (`usize::MAX` if none).
     form_of: Vec<usize>,
     /// Per component: the pin wedge's two unknowns.
@@ -382,10 +410,9 @@ impl Quantizer {
             .map(|&p| [vars[0][p as usize], vars[1][p as usize]])
             .collect();
         let form_of = single_unknown_forms(&forms, n_unknowns);
+        let curve_ends = curve_ends(mesh, &placement.cut, &param.uv, &field.isoline, &cut, &vars, &form_of, &seamless);
         let triples = collapse_triples(&elements, &forms, &form_of);
         let integral = integral_unknowns(mesh, placement, &cut, &vars, &singular, n_unknowns, &forms);
-        let separations = separation::separations(&elements, &integral, &seamless);
-        let separations_of = separation::by_form(&separations, &form_of, forms.len());
         let faces = mesh.faces().to_vec();
         let seamless_areas: Vec<f64> = (0..nf)
             .map(|f| signed_uv_area([param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]))
@@ -405,8 +432,8 @@ impl Quantizer {
             n_unknowns,
             forms,
             triples,
-            separations,
-            separations_of,
+            integral,
+            curve_ends,
             form_of,
             pins,
             seamless,
@@ -507,6 +534,7 @@ impl Quantizer {
         // Rounded with the uniform fit, and where that leaves the map bad,
         // again with the faces around singular points stiffer; the best is kept.
         let stiff = self.stiff_faces(&x0);
+        let rules = self.size_rules(&x0, s);
         // Flipped or collapsed faces leave holes in the quad mesh; a cell
         // the map winds around is closed with quads (an extra singular
         // vertex): fewer of the first, then of the second, count first.
@@ -518,7 +546,7 @@ impl Quantizer {
                 break;
             }
             let fit = Fit::new(&self.elements, &stiff, weight);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, progress)?;
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, progress)?;
             if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
                 best = Some((rounded, s));
             }
@@ -533,13 +561,14 @@ impl Quantizer {
                 }
                 let s_retry = s * factor;
                 let (x0, targets) = start(s_retry);
-                let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, progress)?;
+                let rules = self.size_rules(&x0, s_retry);
+                let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, &rules, progress)?;
                 if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
                     best = Some((rounded, s_retry));
                 }
             }
         }
-        let (Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, .. }, s) =
+        let (Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_violated, .. }, s) =
             best.expect("at least one pass");
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
@@ -555,7 +584,8 @@ impl Quantizer {
         let mut conflicts = 0;
         let mut integer_residual = 0.0f64;
         for (form, value) in self.forms.iter().zip(&values) {
-            let d = (form.value(&x) - value.unwrap_or(0) as f64).abs();
+            let Some(value) = value else { continue };
+            let d = (form.value(&x) - *value as f64).abs();
             integer_residual = integer_residual.max(d);
             if d > 1e-6 {
                 conflicts += 1;
@@ -583,8 +613,10 @@ impl Quantizer {
                 .count(),
             batches,
             separation_moves,
-            separations: self.separations.len(),
-            separations_violated: self.violated_separations(&x).len(),
+            separations,
+            separations_violated,
+            curve_ends: self.curve_ends.len(),
+            free_curve_ends: self.curve_ends.iter().filter(|end| end.length < CURVE_END_CELLS * s).count(),
             moved_integers,
             arap_iterations,
             stiff_weight,
@@ -611,8 +643,10 @@ impl Quantizer {
         x0: &[f64],
         targets: &[[[f64; 2]; 2]],
         s: f64,
+        rules: &SizeRules,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<Rounded, QuantizeError> {
+        let separations = &rules.separations;
         let mut values: Vec<Option<i64>> = vec![None; self.forms.len()];
         let mut order: Vec<usize> = Vec::new();
         let mut x = x0.to_vec();
@@ -622,7 +656,7 @@ impl Quantizer {
         for kind in [FormKind::Cone, FormKind::Point, FormKind::Translation] {
             loop {
                 let mut free: Vec<(f64, usize)> = (0..self.forms.len())
-                    .filter(|&i| values[i].is_none() && self.forms[i].kind == kind)
+                    .filter(|&i| values[i].is_none() && self.forms[i].kind == kind && !rules.free[i])
                     .map(|i| (distance_to_integer(self.forms[i].value(&x)), i))
                     .collect();
                 if free.is_empty() {
@@ -641,7 +675,7 @@ impl Quantizer {
                         values[i] = None;
                     }
                     for &i in &batch {
-                        values[i] = Some(self.rounding(i, &values, &x));
+                        values[i] = Some(self.rounding(i, &values, &x, separations));
                     }
                     order.truncate(before);
                     order.extend(&batch);
@@ -667,7 +701,7 @@ impl Quantizer {
                 };
                 let mut solved = solved;
                 self.restore_parity(&mut solved, &dependent, &mut values, x0, targets)?;
-                separation_moves += self.separate(&mut solved, &mut values, x0, targets)?;
+                separation_moves += self.separate(&mut solved, &mut values, x0, targets, separations)?;
                 x = solved.x.clone();
                 // A candidate the batch's other forms already determine takes the
                 // value the solve gives it.
@@ -701,6 +735,7 @@ impl Quantizer {
                     x0,
                     targets,
                     s,
+                    separations,
                 )?;
                 if moves > 0 {
                     let (polished, moved_bad, iterations, untangle_ok) =
@@ -715,7 +750,22 @@ impl Quantizer {
         let collapsed = (0..self.elements.len()).filter(|&f| self.collapsed(f, &x, s)).count();
         let wound = self.wound_vertices(&x).len();
         let distortion = self.fit_distortion(&x, targets);
-        Ok(Rounded { x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, collapsed, wound, distortion, stiff_weight: fit.stiff_weight })
+        let separations_violated = separations.violated(&x, NEAR_INTEGER).len();
+        Ok(Rounded {
+            x,
+            values,
+            batches,
+            separation_moves,
+            moved_integers,
+            arap_iterations,
+            untangled,
+            collapsed,
+            wound,
+            distortion,
+            stiff_weight: fit.stiff_weight,
+            separations: separations.list.len(),
+            separations_violated,
+        })
     }
 
     /// Area-weighted mean of `|J_f - T_f|^2` over the faces (the fit's
@@ -734,7 +784,7 @@ impl Quantizer {
     /// triangle whose three corners lie on rounded forms of one coordinate
     /// (two feature isolines less than a cell apart, say) onto one grid
     /// line; then the next integer on `i`'s side of the others.
-    fn rounding(&self, i: usize, values: &[Option<i64>], x: &[f64]) -> i64 {
+    fn rounding(&self, i: usize, values: &[Option<i64>], x: &[f64], separations: &Separations) -> i64 {
         let y = self.forms[i].value(x);
         let v = y.round() as i64;
         for triple in &self.triples[i] {
@@ -749,30 +799,20 @@ impl Quantizer {
                     (l.min(y), h.max(y))
                 });
             if y > hi {
-                return self.separated(i, v + 1, values);
+                return self.separated(i, v + 1, values, separations);
             } else if y < lo {
-                return self.separated(i, v - 1, values);
+                return self.separated(i, v - 1, values, separations);
             }
         }
-        self.separated(i, v, values)
+        self.separated(i, v, values, separations)
     }
 
     /// `v` moved the least so that form `i` stays a grid line apart from
     /// every rounded form it must be separated from; `v` when no integer
     /// meets all of them.
-    fn separated(&self, i: usize, v: i64, values: &[Option<i64>]) -> i64 {
-        let (mut lower, mut upper) = (i64::MIN, i64::MAX);
+    fn separated(&self, i: usize, v: i64, values: &[Option<i64>], separations: &Separations) -> i64 {
         let value = |u: usize| self.form_of.get(u).and_then(|&f| values.get(f).copied().flatten());
-        for &k in &self.separations_of[i] {
-            let sep = self.separations[k];
-            if self.form_of[sep.hi] == i {
-                if let Some(lo) = value(sep.lo) {
-                    lower = lower.max(lo + 1);
-                }
-            } else if let Some(hi) = value(sep.hi) {
-                upper = upper.min(hi - 1);
-            }
-        }
+        let (lower, upper) = separations.bounds(i, &self.form_of, value);
         if lower <= upper {
             v.clamp(lower, upper)
         } else {
@@ -795,18 +835,16 @@ impl Quantizer {
         }
     }
 
-    /// Separations whose two unknowns are integers in `x` (rounded or
-    /// determined) and less than a grid line apart.
-    fn violated_separations(&self, x: &[f64]) -> Vec<Separation> {
-        self.separations
-            .iter()
-            .copied()
-            .filter(|s| {
-                distance_to_integer(x[s.lo]) < NEAR_INTEGER
-                    && distance_to_integer(x[s.hi]) < NEAR_INTEGER
-                    && x[s.hi] - x[s.lo] < 1.0 - NEAR_INTEGER
-            })
-            .collect()
+    /// The rules of grid size `s` for the seamless map `x0` (grid units):
+    /// the separations within [`SEPARATION_RADIUS`], and the ends of curves
+    /// shorter than [`CURVE_END_CELLS`] left free.
+    fn size_rules(&self, x0: &[f64], s: f64) -> SizeRules {
+        let separations = Separations::new(&self.elements, &self.integral, x0, SEPARATION_RADIUS, &self.form_of, self.forms.len());
+        let mut free = vec![false; self.forms.len()];
+        for end in self.curve_ends.iter().filter(|end| end.length < CURVE_END_CELLS * s) {
+            free[end.form] = true;
+        }
+        SizeRules { separations, free }
     }
 
     /// Restores violated separations after a batch: a form the others
@@ -826,8 +864,9 @@ impl Quantizer {
         values: &mut [Option<i64>],
         x0: &[f64],
         targets: &[[[f64; 2]; 2]],
+        separations: &Separations,
     ) -> Result<usize, QuantizeError> {
-        let mut violated = self.violated_separations(&system.x);
+        let mut violated = separations.violated(&system.x, NEAR_INTEGER);
         let (mut moves, mut trials, mut sideways) = (0, 0, 0);
         let mut seen = std::collections::HashSet::new();
         seen.insert(values.to_vec());
@@ -873,7 +912,7 @@ impl Quantizer {
                     if !self.rounded_forms_integral(&trial, &x) {
                         continue;
                     }
-                    let after = self.violated_separations(&x);
+                    let after = separations.violated(&x, NEAR_INTEGER);
                     if after.len() < violated.len() {
                         best = Some(SeparationMove { row, step, x, values: trial, violated: after });
                         improved = true;
@@ -1043,9 +1082,10 @@ impl Quantizer {
         x0: &[f64],
         targets: &[[[f64; 2]; 2]],
         s: f64,
+        separations: &Separations,
     ) -> Result<usize, QuantizeError> {
         let mut badness = self.badness(x, s);
-        let violated = self.violated_separations(x).len();
+        let violated = separations.violated(x, NEAR_INTEGER).len();
         let (mut trials, mut kept) = (0, 0);
         let mut tried = std::collections::HashSet::new();
         let (max_trials, max_probes) = (self.budget(UNCOLLAPSE_TRIALS), self.budget(UNCOLLAPSE_PROBES));
@@ -1085,7 +1125,7 @@ impl Quantizer {
                 system.b[row] += step as f64;
                 let moved = system.resolve(self, targets)?;
                 let after = self.badness(&moved, s);
-                if self.rounded_forms_integral(values, &moved) && after < badness && self.violated_separations(&moved).len() <= violated {
+                if self.rounded_forms_integral(values, &moved) && after < badness && separations.violated(&moved, NEAR_INTEGER).len() <= violated {
                     values[form] = Some(v);
                     self.take_determined_values(values, &moved);
                     system.x = moved.clone();
@@ -1258,6 +1298,16 @@ struct Rounded {
     wound: usize,
     distortion: f64,
     stiff_weight: f64,
+    /// Separations of its grid size, and those `x` leaves violated.
+    separations: usize,
+    separations_violated: usize,
+}
+
+/// What quantization at one grid size keeps to beyond the forms.
+struct SizeRules {
+    separations: Separations,
+    /// Per form: left free (the end of a curve shorter than [`CURVE_END_CELLS`] cells).
+    free: Vec<bool>,
 }
 
 /// One integer moved by [`Quantizer::separate`]: the row of `c` changed by
@@ -1385,6 +1435,61 @@ fn singular_cut_vertices(cm: &TriMesh, uv: &[[f64; 2]]) -> Vec<bool> {
             (sums[v as usize] - straight).abs() > FRAC_PI_4
         })
         .collect()
+}
+
+/// The ends of feature curves inside the mesh (a cut boundary vertex of an
+/// interior vertex, UV angle 2 pi: the isoline runs straight on through
+/// it), each as the form of its coordinate along the curve and the curve's
+/// length in the seamless map `seamless` (the extent of its isoline's
+/// wedges along it).
+fn curve_ends(
+    mesh: &TriMesh,
+    cut_mesh: &CutMesh,
+    uv: &[[f64; 2]],
+    isoline: &[u8],
+    cut: &CutGraph,
+    vars: &[Vec<usize>; 2],
+    form_of: &[usize],
+    seamless: &[f64],
+) -> Vec<CurveEnd> {
+    let cm = &cut_mesh.mesh;
+    let sums = corner_angle_sums(cm.faces(), cm.n_vertices(), |f| [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]);
+    let is_end = |v: u32| {
+        cm.is_boundary_vertex(v)
+            && !mesh.is_boundary_vertex(cut_mesh.original_vertex[v as usize])
+            && (sums[v as usize] - 2.0 * PI).abs() < FRAC_PI_4
+    };
+    // Per isoline unknown: the extent of its wedges along the other coordinate.
+    let mut extent: std::collections::HashMap<usize, (f64, f64)> = Default::default();
+    for w in 0..vars[0].len() {
+        for c in 0..2 {
+            if form_of[vars[c][w]] != usize::MAX {
+                let y = seamless[vars[1 - c][w]];
+                let e = extent.entry(vars[c][w]).or_insert((y, y));
+                *e = (e.0.min(y), e.1.max(y));
+            }
+        }
+    }
+    let mut ends = Vec::new();
+    let mut seen = vec![false; cm.n_vertices()];
+    for (f, face) in cm.faces().iter().enumerate() {
+        for k in 0..3 {
+            let v = face[k];
+            // The isoline's coordinate: that of a feature halfedge at this corner.
+            let Some(c) = [3 * f + k, 3 * f + (k + 2) % 3].iter().map(|&h| isoline[h] as usize).find(|&c| c < 2) else { continue };
+            if seen[v as usize] || !is_end(v) {
+                continue;
+            }
+            seen[v as usize] = true;
+            let w = cut.wedge[3 * f + k] as usize;
+            let (lo, hi) = extent[&vars[c][w]];
+            let form = form_of[vars[1 - c][w]];
+            if form != usize::MAX {
+                ends.push(CurveEnd { form, length: hi - lo });
+            }
+        }
+    }
+    ends
 }
 
 /// Per unknown: the form that is that unknown alone (a singular point's

@@ -12,10 +12,14 @@
 //! is not rounded itself (a cone's wedge on the far side of a seam) becomes
 //! integer once the translations are. Two are *near* when their
 //! vertices share the star of a disk vertex (at most two edges apart, never
-//! across a seam), and *side by side along `c`* when their displacement in
-//! the seamless map is at least as long along `c` as along the other
-//! coordinate (a cone at the end of an isoline, or two cones one above the
-//! other, may share the line); or when they are the corners of one triangle
+//! across a seam), or when one is a singular point (a cone or corner: both
+//! coordinates integers) and the other within a grid cell of it through the
+//! triangles of its chart (on a fine mesh a cell spans several edges, and
+//! two cones four edges apart could otherwise share a grid point); and
+//! *side by side along `c`* when their displacement in the seamless map is
+//! at least as long along `c` as along the other coordinate (a cone at the
+//! end of an isoline, or two cones one above the other, may share the
+//! line); or when they are the corners of one triangle
 //! (which they would collapse, whatever the direction); or when one is an
 //! isoline and the other lies between two of its vertices along it (a cone
 //! a fraction of a cell from a feature curve: the CAD cylinder's rim).
@@ -31,59 +35,65 @@ pub(super) struct Separation {
 }
 
 /// The separations among the unknowns marked `integral`, from the seamless map
-/// `seamless` (any scale: only directions and signs are used). A pair whose
+/// `seamless` in grid units: pairs near in the star of a disk vertex (any
+/// scale), and pairs of a singular point and a corner within `radius` grid
+/// units of it through the chart (where a cell spans several edges, two
+/// cones less than a cell apart are further apart than a star). A pair whose
 /// order differs between two of its vertex pairs is left out (it cannot be
 /// kept apart on one side).
-pub(super) fn separations(elements: &[Element], integral: &[bool], seamless: &[f64]) -> Vec<Separation> {
+pub(super) fn separations(elements: &[Element], integral: &[bool], seamless: &[f64], radius: f64) -> Vec<Separation> {
     let n_wedges = elements.iter().flat_map(|el| el.w).max().map_or(0, |w| w + 1);
     // Per wedge: the form corners of its star, (unknown, coordinate, seamless uv).
-    let mut star: Vec<Vec<(usize, usize, [f64; 2])>> = vec![Vec::new(); n_wedges];
+    let mut star: Vec<Vec<Corner>> = vec![Vec::new(); n_wedges];
     for el in elements {
-        for k in 0..3 {
-            let p = [seamless[el.x[0][k]], seamless[el.x[1][k]]];
-            for c in 0..2 {
-                let form = el.x[c][k];
-                if !integral[form] {
-                    continue;
-                }
-                for &w in &el.w {
-                    if !star[w].iter().any(|e| e.0 == form && e.2 == p) {
-                        star[w].push((form, c, p));
-                    }
-                }
+        for corner in form_corners(el, integral, seamless) {
+            for &w in &el.w {
+                push_corner(&mut star[w], corner);
             }
         }
     }
     let mut found: HashSet<Separation> = HashSet::new();
     for corners in &star {
-        for (i, &(a, c, pa)) in corners.iter().enumerate() {
-            for &(b, cb, pb) in &corners[i + 1..] {
-                if a == b || c != cb {
-                    continue;
-                }
-                let d = [pb[0] - pa[0], pb[1] - pa[1]];
-                if d[c].abs() < d[1 - c].abs() || d[c] == 0.0 {
-                    continue;
-                }
-                found.insert(if d[c] > 0.0 { Separation { lo: a, hi: b } } else { Separation { lo: b, hi: a } });
-            }
+        side_by_side(corners, 0..corners.len(), &mut found);
+    }
+    // Pairs of a singular point (both coordinates integers) and the corners
+    // within `radius` of it, reached through the triangles of its chart.
+    let mut elements_of: Vec<Vec<usize>> = vec![Vec::new(); n_wedges];
+    for (f, el) in elements.iter().enumerate() {
+        for &w in &el.w {
+            elements_of[w].push(f);
         }
-        // An isoline (one unknown at several corners of the star) is a line:
-        // a corner beside it, between its ends along the line, is side by
-        // side with it across the line however short the step to the line
-        // (a cone next to a feature curve, between two of its vertices).
-        for &(b, c, pb) in corners {
-            let along = corners.iter().filter(|e| e.0 == b).map(|e| e.2[1 - c]);
-            let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
-            if !(hi > lo) {
+    }
+    let mut seen = vec![usize::MAX; n_wedges];
+    let mut ball: Vec<Corner> = Vec::new();
+    for el0 in elements {
+        for k0 in 0..3 {
+            let w0 = el0.w[k0];
+            if radius <= 0.0 || seen[w0] == w0 || !(0..2).all(|c| integral[el0.x[c][k0]]) {
                 continue;
             }
-            for &(a, ca, pa) in corners {
-                if a == b || ca != c || !(lo..=hi).contains(&pa[1 - c]) || pa[c] == pb[c] {
-                    continue;
+            let p0 = [seamless[el0.x[0][k0]], seamless[el0.x[1][k0]]];
+            ball.clear();
+            ball.extend((0..2).map(|c| (el0.x[c][k0], c, p0)));
+            seen[w0] = w0;
+            let mut stack = vec![w0];
+            while let Some(w) = stack.pop() {
+                for &f in &elements_of[w] {
+                    let el = &elements[f];
+                    for corner in form_corners(el, integral, seamless) {
+                        push_corner(&mut ball, corner);
+                    }
+                    for k in 0..3 {
+                        let u = el.w[k];
+                        let p = [seamless[el.x[0][k]], seamless[el.x[1][k]]];
+                        if seen[u] != w0 && (p[0] - p0[0]).hypot(p[1] - p0[1]) < radius {
+                            seen[u] = w0;
+                            stack.push(u);
+                        }
+                    }
                 }
-                found.insert(if pb[c] > pa[c] { Separation { lo: a, hi: b } } else { Separation { lo: b, hi: a } });
             }
+            side_by_side(&ball, 0..2, &mut found);
         }
     }
     // A triangle whose corners are two forms of one coordinate collapses
@@ -111,18 +121,102 @@ pub(super) fn separations(elements: &[Element], integral: &[bool], seamless: &[f
     list
 }
 
-/// Per form: the separations it takes part in (indices into `list`), with
-/// `form_of` the form of each unknown that is one (`usize::MAX` if none).
-pub(super) fn by_form(list: &[Separation], form_of: &[usize], n_forms: usize) -> Vec<Vec<usize>> {
-    let mut of = vec![Vec::new(); n_forms];
-    for (i, s) in list.iter().enumerate() {
-        for u in [s.lo, s.hi] {
-            if form_of[u] != usize::MAX {
-                of[form_of[u]].push(i);
+/// A corner of an integer unknown: (unknown, coordinate, seamless uv).
+type Corner = (usize, usize, [f64; 2]);
+
+/// The corners of `el` whose unknowns are `integral`.
+fn form_corners<'a>(el: &'a Element, integral: &'a [bool], seamless: &'a [f64]) -> impl Iterator<Item = Corner> + 'a {
+    (0..3).flat_map(move |k| {
+        let p = [seamless[el.x[0][k]], seamless[el.x[1][k]]];
+        (0..2).filter(move |&c| integral[el.x[c][k]]).map(move |c| (el.x[c][k], c, p))
+    })
+}
+
+/// Adds `corner` to `corners` unless it is there.
+fn push_corner(corners: &mut Vec<Corner>, corner: Corner) {
+    if !corners.iter().any(|e| e.0 == corner.0 && e.2 == corner.2) {
+        corners.push(corner);
+    }
+}
+
+/// The separations between the corners `corners[centre]` and the others of
+/// `corners` (all near each other): side by side along their coordinate, or
+/// one beside an isoline between its ends along it (a cone next to a feature
+/// curve, between two of its vertices, however short the step to the line).
+fn side_by_side(corners: &[Corner], centre: std::ops::Range<usize>, found: &mut HashSet<Separation>) {
+    let ordered = |a: usize, b: usize, ya: f64, yb: f64| if yb > ya { Separation { lo: a, hi: b } } else { Separation { lo: b, hi: a } };
+    for &(a, c, pa) in &corners[centre.clone()] {
+        for &(b, cb, pb) in corners {
+            let d = [pb[0] - pa[0], pb[1] - pa[1]];
+            if a == b || c != cb || d[c].abs() < d[1 - c].abs() || d[c] == 0.0 {
+                continue;
             }
+            found.insert(ordered(a, b, pa[c], pb[c]));
         }
     }
-    of
+    // An isoline (one unknown at several corners) is a line: a corner beside
+    // it between its ends along the line is side by side with it across it.
+    for &(b, c, pb) in corners {
+        let along = corners.iter().filter(|e| e.0 == b).map(|e| e.2[1 - c]);
+        let (lo, hi) = along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        if !(hi > lo) {
+            continue;
+        }
+        for &(a, ca, pa) in &corners[centre.clone()] {
+            if a == b || ca != c || !(lo..=hi).contains(&pa[1 - c]) || pa[c] == pb[c] {
+                continue;
+            }
+            found.insert(ordered(a, b, pa[c], pb[c]));
+        }
+    }
+}
+
+/// The separations of one grid size, and per form the ones it is in.
+pub(super) struct Separations {
+    pub list: Vec<Separation>,
+    of_form: Vec<Vec<usize>>,
+}
+
+impl Separations {
+    /// [`separations`] of the unknowns `integral` in the seamless map `seamless`
+    /// (grid units) within `radius`, indexed by `form_of` (per unknown, the form
+    /// that is it alone, `usize::MAX` if none; `n_forms` forms).
+    pub fn new(elements: &[Element], integral: &[bool], seamless: &[f64], radius: f64, form_of: &[usize], n_forms: usize) -> Separations {
+        let list = separations(elements, integral, seamless, radius);
+        let mut of_form = vec![Vec::new(); n_forms];
+        for (i, s) in list.iter().enumerate() {
+            for u in [s.lo, s.hi] {
+                if form_of[u] != usize::MAX {
+                    of_form[form_of[u]].push(i);
+                }
+            }
+        }
+        Separations { list, of_form }
+    }
+
+    /// The integers form `i` (the unknown `form_of` maps to `i`) may take to
+    /// stay a grid line from every rounded form (`value` of an unknown) it is
+    /// separated from: `(lower, upper)`, empty when no integer meets all.
+    pub fn bounds(&self, i: usize, form_of: &[usize], value: impl Fn(usize) -> Option<i64>) -> (i64, i64) {
+        let (mut lower, mut upper) = (i64::MIN, i64::MAX);
+        for &k in &self.of_form[i] {
+            let sep = self.list[k];
+            if form_of[sep.hi] == i {
+                if let Some(lo) = value(sep.lo) {
+                    lower = lower.max(lo + 1);
+                }
+            } else if let Some(hi) = value(sep.hi) {
+                upper = upper.min(hi - 1);
+            }
+        }
+        (lower, upper)
+    }
+
+    /// Separations whose two unknowns are integers in `x` (to `near`) and less than a grid line apart.
+    pub fn violated(&self, x: &[f64], near: f64) -> Vec<Separation> {
+        let integer = |y: f64| (y - y.round()).abs() < near;
+        self.list.iter().copied().filter(|s| integer(x[s.lo]) && integer(x[s.hi]) && x[s.hi] - x[s.lo] < 1.0 - near).collect()
+    }
 }
 
 #[cfg(test)]
@@ -148,6 +242,35 @@ mod tests {
         for u in [3, 10, 11] {
             integral[u] = true;
         }
-        assert_eq!(separations(&elements, &integral, &seamless), vec![Separation { lo: 10, hi: 11 }]);
+        assert_eq!(separations(&elements, &integral, &seamless, 0.0), vec![Separation { lo: 10, hi: 11 }]);
+    }
+
+    /// Two cones four edges apart on a strip whose cell spans five edges
+    /// share no star, yet could round onto one grid line: within a radius of
+    /// a cell they are kept a line apart along the coordinate they are side
+    /// by side in (u), and not along the one they share (v).
+    #[test]
+    fn cones_within_a_cell_are_kept_apart_beyond_their_stars() {
+        // Vertices (i, j), i in 0..=5, j in 0..=1; wedge = vertex; u unknown
+        // = vertex, v unknown = 12 + vertex; the cones are vertices 0 and 4.
+        let id = |i: usize, j: usize| j * 6 + i;
+        let mut elements = Vec::new();
+        for i in 0..5 {
+            let (a, b, c, d) = (id(i, 0), id(i + 1, 0), id(i + 1, 1), id(i, 1));
+            for w in [[a, b, c], [a, c, d]] {
+                let q = w.map(|v| [(v % 6) as f64, (v / 6) as f64]);
+                elements.push(Element::new(q, 0.5, w, [w, w.map(|v| 12 + v)]));
+            }
+        }
+        let mut seamless = vec![0.0; 24];
+        for v in 0..12 {
+            (seamless[v], seamless[12 + v]) = (0.2 * (v % 6) as f64, 0.2 * (v / 6) as f64);
+        }
+        let mut integral = vec![false; 24];
+        for u in [0, 4, 12, 16] {
+            integral[u] = true;
+        }
+        assert_eq!(separations(&elements, &integral, &seamless, 0.0), vec![]);
+        assert_eq!(separations(&elements, &integral, &seamless, 1.0), vec![Separation { lo: 0, hi: 4 }]);
     }
 }
