@@ -243,6 +243,9 @@ export interface QuantizeReport {
   /** Pairs of integers (cones, corners, isolines side by side) to be kept a grid line apart, and those left closer. */
   separations: number;
   separations_violated: number;
+  /** Ends of feature curves inside the mesh, and those left off the grid points (their curve shorter than a cell). */
+  curve_ends: number;
+  free_curve_ends: number;
   /** Integers moved by one to undo a collapse. */
   moved_integers: number;
   arap_iterations: number;
@@ -326,7 +329,7 @@ export interface QuadsResult {
 
 export const QUANTIZE_REPORT_KEYS = {
   grid_size: true, point_forms: true, translation_forms: true, batches: true, separation_moves: true, separations: true,
-  separations_violated: true, moved_integers: true, arap_iterations: true, stiff_weight: true,
+  separations_violated: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiff_weight: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
   wound_vertices: true, cells: true, seconds: true,
 } as const satisfies Keys<QuantizeReport>;
