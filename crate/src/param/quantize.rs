@@ -259,6 +259,13 @@ struct CurveEnd {
     length: f64,
 }
 
+impl CurveEnd {
+    /// Whether the end is left free at grid size `s`.
+    fn free_at(&self, s: f64) -> bool {
+        self.length < CURVE_END_CELLS * s
+    }
+}
+
 /// A linear form of the unknowns that must take an integer value.
 #[derive(Clone, Debug)]
 struct Form {
@@ -616,7 +623,7 @@ impl Quantizer {
             separations,
             separations_violated,
             curve_ends: self.curve_ends.len(),
-            free_curve_ends: self.curve_ends.iter().filter(|end| end.length < CURVE_END_CELLS * s).count(),
+            free_curve_ends: self.curve_ends.iter().filter(|end| end.free_at(s)).count(),
             moved_integers,
             arap_iterations,
             stiff_weight,
@@ -841,7 +848,7 @@ impl Quantizer {
     fn size_rules(&self, x0: &[f64], s: f64) -> SizeRules {
         let separations = Separations::new(&self.elements, &self.integral, x0, SEPARATION_RADIUS, &self.form_of, self.forms.len());
         let mut free = vec![false; self.forms.len()];
-        for end in self.curve_ends.iter().filter(|end| end.length < CURVE_END_CELLS * s) {
+        for end in self.curve_ends.iter().filter(|end| end.free_at(s)) {
             free[end.form] = true;
         }
         SizeRules { separations, free }
