@@ -116,3 +116,51 @@ impl Element {
         self.w.map(|w| uv[w])
     }
 }
+
+/// Walks of a cut disk's elements near a wedge (the elements around the
+/// wedges whose UV lies within a radius of the start), through wedges, so
+/// never across a seam: per wedge the elements around it, and per wedge the
+/// walk that reached it last.
+pub(super) struct NearWedges {
+    elements_of: Vec<Vec<usize>>,
+    seen: Vec<usize>,
+}
+
+impl NearWedges {
+    /// For `elements` on `n_wedges` wedges.
+    pub(super) fn new(elements: &[Element], n_wedges: usize) -> NearWedges {
+        let mut elements_of = vec![Vec::new(); n_wedges];
+        for (f, el) in elements.iter().enumerate() {
+            for &w in &el.w {
+                elements_of[w].push(f);
+            }
+        }
+        NearWedges { elements_of, seen: vec![usize::MAX; n_wedges] }
+    }
+
+    /// Whether a walk started at wedge `w` already.
+    pub(super) fn started(&self, w: usize) -> bool {
+        self.seen[w] == w
+    }
+
+    /// Calls `visit(f)` for every element around each wedge reached from
+    /// `w0` (UV `p0` in the unknowns `x`) through wedges within `radius` of
+    /// `p0` (an element around two reached wedges comes twice).
+    pub(super) fn walk(&mut self, elements: &[Element], x: &[f64], w0: usize, p0: [f64; 2], radius: f64, mut visit: impl FnMut(usize)) {
+        self.seen[w0] = w0;
+        let mut stack = vec![w0];
+        while let Some(w) = stack.pop() {
+            for &f in &self.elements_of[w] {
+                visit(f);
+                let el = &elements[f];
+                for k in 0..3 {
+                    let (u, p) = (el.w[k], [x[el.x[0][k]], x[el.x[1][k]]]);
+                    if self.seen[u] != w0 && (p[0] - p0[0]).hypot(p[1] - p0[1]) < radius {
+                        self.seen[u] = w0;
+                        stack.push(u);
+                    }
+                }
+            }
+        }
+    }
+}

@@ -54,7 +54,7 @@
 //! per ARAP iteration.
 
 use super::cut_graph::{cut_graph, CutGraph};
-use super::element::{signed_uv_area, Element};
+use super::element::{signed_uv_area, Element, NearWedges};
 use super::field::cross_field;
 use super::metrics;
 use super::seamless::{
@@ -401,7 +401,8 @@ impl Quantizer {
             }
         }
         let component = wedge_components(&cut);
-        let singular = singular_cut_vertices(&placement.cut.mesh, &param.uv);
+        let cut_sums = corner_angle_sums(cm.faces(), cm.n_vertices(), |f| [param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]);
+        let singular = singular_cut_vertices(cm, &cut_sums);
         let forms = integer_forms(
             mesh,
             placement,
@@ -417,7 +418,7 @@ impl Quantizer {
             .map(|&p| [vars[0][p as usize], vars[1][p as usize]])
             .collect();
         let form_of = single_unknown_forms(&forms, n_unknowns);
-        let curve_ends = curve_ends(mesh, &placement.cut, &param.uv, &field.isoline, &cut, &vars, &form_of, &seamless);
+        let curve_ends = curve_ends(mesh, &placement.cut, &cut_sums, &field.isoline, &cut, &vars, &form_of, &seamless);
         let triples = collapse_triples(&elements, &forms, &form_of);
         let integral = integral_unknowns(mesh, placement, &cut, &vars, &singular, n_unknowns, &forms);
         let faces = mesh.faces().to_vec();
@@ -458,34 +459,11 @@ impl Quantizer {
     /// the ring along and leave the distortion to the regular faces beyond.
     fn stiff_faces(&self, x0: &[f64]) -> Vec<bool> {
         let n_wedges = self.vars[0].len();
-        let mut elements_of: Vec<Vec<usize>> = vec![Vec::new(); n_wedges];
-        for (f, el) in self.elements.iter().enumerate() {
-            for &w in &el.w {
-                elements_of[w].push(f);
-            }
-        }
-        let uv = |w: usize| [x0[self.vars[0][w]], x0[self.vars[1][w]]];
+        let mut near = NearWedges::new(&self.elements, n_wedges);
         let mut stiff = vec![false; self.elements.len()];
-        let mut seen = vec![usize::MAX; n_wedges];
         for c in (0..n_wedges).filter(|&w| (0..2).all(|k| self.form_of[self.vars[k][w]] != usize::MAX)) {
-            let p = uv(c);
-            let near = |w: usize| {
-                let q = uv(w);
-                (q[0] - p[0]).hypot(q[1] - p[1]) < STIFF_RADIUS
-            };
-            let mut stack = vec![c];
-            seen[c] = c;
-            while let Some(w) = stack.pop() {
-                for &f in &elements_of[w] {
-                    stiff[f] = true;
-                    for &u in &self.elements[f].w {
-                        if seen[u] != c && near(u) {
-                            seen[u] = c;
-                            stack.push(u);
-                        }
-                    }
-                }
-            }
+            let p = [x0[self.vars[0][c]], x0[self.vars[1][c]]];
+            near.walk(&self.elements, x0, c, p, STIFF_RADIUS, |f| stiff[f] = true);
         }
         stiff
     }
@@ -1432,10 +1410,9 @@ fn integral_unknowns(
     integral
 }
 
-/// Per cut vertex: whether its UV angle sum in `uv` is off the straight
+/// Per cut vertex: whether its UV angle sum (`sums`) is off the straight
 /// angle (2 pi inside, pi on the boundary) by more than pi / 4.
-fn singular_cut_vertices(cm: &TriMesh, uv: &[[f64; 2]]) -> Vec<bool> {
-    let sums = corner_angle_sums(cm.faces(), cm.n_vertices(), |f| [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]);
+fn singular_cut_vertices(cm: &TriMesh, sums: &[f64]) -> Vec<bool> {
     (0..cm.n_vertices() as u32)
         .map(|v| {
             let straight = if cm.is_boundary_vertex(v) { PI } else { 2.0 * PI };
@@ -1445,14 +1422,14 @@ fn singular_cut_vertices(cm: &TriMesh, uv: &[[f64; 2]]) -> Vec<bool> {
 }
 
 /// The ends of feature curves inside the mesh (a cut boundary vertex of an
-/// interior vertex, UV angle 2 pi: the isoline runs straight on through
-/// it), each as the form of its coordinate along the curve and the curve's
+/// interior vertex, UV angle sum in `sums` 2 pi: the isoline runs straight
+/// on through it), each as the form of its coordinate along the curve and the curve's
 /// length in the seamless map `seamless` (the extent of its isoline's
 /// wedges along it).
 fn curve_ends(
     mesh: &TriMesh,
     cut_mesh: &CutMesh,
-    uv: &[[f64; 2]],
+    sums: &[f64],
     isoline: &[u8],
     cut: &CutGraph,
     vars: &[Vec<usize>; 2],
@@ -1460,7 +1437,6 @@ fn curve_ends(
     seamless: &[f64],
 ) -> Vec<CurveEnd> {
     let cm = &cut_mesh.mesh;
-    let sums = corner_angle_sums(cm.faces(), cm.n_vertices(), |f| [uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]);
     let is_end = |v: u32| {
         cm.is_boundary_vertex(v)
             && !mesh.is_boundary_vertex(cut_mesh.original_vertex[v as usize])

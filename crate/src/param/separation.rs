@@ -24,7 +24,7 @@
 //! isoline and the other lies between two of its vertices along it (a cone
 //! a fraction of a cell from a feature curve: the CAD cylinder's rim).
 
-use super::element::Element;
+use super::element::{Element, NearWedges};
 use std::collections::HashSet;
 
 /// Unknown `hi` must exceed unknown `lo` by at least one (grid units).
@@ -58,41 +58,22 @@ pub(super) fn separations(elements: &[Element], integral: &[bool], seamless: &[f
     }
     // Pairs of a singular point (both coordinates integers) and the corners
     // within `radius` of it, reached through the triangles of its chart.
-    let mut elements_of: Vec<Vec<usize>> = vec![Vec::new(); n_wedges];
-    for (f, el) in elements.iter().enumerate() {
-        for &w in &el.w {
-            elements_of[w].push(f);
-        }
-    }
-    let mut seen = vec![usize::MAX; n_wedges];
+    let mut near = NearWedges::new(elements, n_wedges);
     let mut ball: Vec<Corner> = Vec::new();
     for el0 in elements {
         for k0 in 0..3 {
             let w0 = el0.w[k0];
-            if radius <= 0.0 || seen[w0] == w0 || !(0..2).all(|c| integral[el0.x[c][k0]]) {
+            if radius <= 0.0 || near.started(w0) || !(0..2).all(|c| integral[el0.x[c][k0]]) {
                 continue;
             }
             let p0 = [seamless[el0.x[0][k0]], seamless[el0.x[1][k0]]];
             ball.clear();
             ball.extend((0..2).map(|c| (el0.x[c][k0], c, p0)));
-            seen[w0] = w0;
-            let mut stack = vec![w0];
-            while let Some(w) = stack.pop() {
-                for &f in &elements_of[w] {
-                    let el = &elements[f];
-                    for corner in form_corners(el, integral, seamless) {
-                        push_corner(&mut ball, corner);
-                    }
-                    for k in 0..3 {
-                        let u = el.w[k];
-                        let p = [seamless[el.x[0][k]], seamless[el.x[1][k]]];
-                        if seen[u] != w0 && (p[0] - p0[0]).hypot(p[1] - p0[1]) < radius {
-                            seen[u] = w0;
-                            stack.push(u);
-                        }
-                    }
+            near.walk(elements, seamless, w0, p0, radius, |f| {
+                for corner in form_corners(&elements[f], integral, seamless) {
+                    push_corner(&mut ball, corner);
                 }
-            }
+            });
             side_by_side(&ball, 0..2, &mut found);
         }
     }
