@@ -1465,7 +1465,7 @@ fn curve_ends(
             }
             seen[v as usize] = true;
             let w = cut.wedge[3 * f + k] as usize;
-            let (lo, hi) = extent[&vars[c][w]];
+            let Some(&(lo, hi)) = extent.get(&vars[c][w]) else { continue };
             let form = form_of[vars[1 - c][w]];
             if form != usize::MAX {
                 ends.push(CurveEnd { form, length: hi - lo });
