@@ -482,3 +482,22 @@ fn feature_curves_that_end_inside_a_cell_are_not_stretched_to_it() {
     assert!(r.distortion_after < 2.0 * r.distortion_before, "{r:?}");
     assert_eq!(check_integer_grid_counting_cones("creased sheet", &solution.mesh, &solution.features, &map.uv), (0, 0, 0));
 }
+
+/// A game asset of 56 parts (xatlas's gazebo sample) at 3 000 quads: many
+/// parts are planks and boxes thinner than a cell, whose eight corner
+/// cones the rounding put on one grid line across the thin side; moving one
+/// integer at a time could not part them (each move broke the neighbouring
+/// pairs: 3 flipped triangles and 2 wound vertices). The pass that holds
+/// the violated separations as rows of the relaxed map parts them all.
+#[test]
+fn parts_thinner_than_a_cell_are_held_apart() {
+    let input = load("xatlas-gazebo.obj");
+    let features = FeatureSet::none(&input);
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert!(r.separations_held > 0, "the case this tests is gone: {r:?}");
+    assert_eq!((r.conflicts, r.flipped, r.wound_vertices, r.separations_violated), (0, 0, 0, 0), "{r:?}");
+    let (flipped, off_grid, _) = check_integer_grid_counting_cones("xatlas-gazebo", &solution.mesh, &solution.features, &map.uv);
+    assert_eq!((flipped, off_grid), (0, 0));
+}

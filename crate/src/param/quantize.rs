@@ -41,11 +41,20 @@
 //! leaves the map bad, the whole rounding runs again with the faces within
 //! one grid unit of every singular point [`STIFF_WEIGHTS`] times stiffer, so
 //! the ring moves with its point; the pass with the fewest collapsed faces,
-//! then wound vertices, then the least fit distortion is kept.
+//! then wound vertices, then the least fit distortion is kept. Where the
+//! map is still bad, one more pass holds the separations as rows
+//! ([`HeldApart`]): every pair a solve leaves less than a grid line apart is
+//! held exactly one apart in the solves that follow, the collapse
+//! constraints of Bommes et al. 2013 as an active set on the relaxed map,
+//! so that the rounding starts from a map that already keeps them apart
+//! (where a cell is wider than a part of the surface, a plank or a box
+//! thinner than a cell, the moves of [`Quantizer::separate`] one integer
+//! at a time cannot undo the collapse: each breaks the neighbouring pairs).
 //!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
-//! batch (the rows change; about ten batches), and up to three passes where
-//! the plain fit leaves the map bad. With that factorization:
+//! batch (the rows change; about ten batches), and up to four passes where
+//! the plain fit leaves the map bad (the held pass: up to [`HOLD_ROUNDS`]
+//! more factorizations before its first batch). With that factorization:
 //! one adjoint solve per violated separation and one solve per move tried
 //! (at most [`SEPARATION_TRIALS`] per batch, fewer on large meshes:
 //! [`FULL_BUDGET_FACES`]); after the last batch, one
@@ -150,6 +159,10 @@ const STIFF_RADIUS: f64 = 1.0;
 /// cones; where dense features fold the map in many places they cost two
 /// more roundings for little.
 const STIFF_PASS_LIMIT: usize = 16;
+
+/// Solves of the relaxed map before the held pass's first batch, each
+/// holding the separations the one before left violated ([`HeldApart`]).
+const HOLD_ROUNDS: usize = 3;
 
 /// Meshes up to this many faces get the full budgets of extra solves
 /// ([`SEPARATION_TRIALS`], [`UNCOLLAPSE_TRIALS`], [`UNCOLLAPSE_PROBES`] and
@@ -293,13 +306,16 @@ pub struct QuantizeReport {
     pub translation_forms: usize,
     /// Rounding batches (each one KKT analysis + factorization).
     pub batches: usize,
-    /// Integers moved by one to keep separated forms a grid line apart
-    /// ([`Quantizer::separate`]).
+    /// Integers moved (by one or two) to keep separated forms a grid line
+    /// apart ([`Quantizer::separate`]).
     pub separation_moves: usize,
     /// Pairs of forms to be kept a grid line apart, and those left closer
     /// (each one a collapse).
     pub separations: usize,
     pub separations_violated: usize,
+    /// Separations held as rows in the pass kept (0 unless the held pass
+    /// was run and kept: [`HeldApart`]).
+    pub separations_held: usize,
     /// Ends of feature curves inside the mesh, and those left off the grid
     /// points (their curve shorter than a cell).
     pub curve_ends: usize,
@@ -531,7 +547,17 @@ impl Quantizer {
                 break;
             }
             let fit = Fit::new(&self.elements, &stiff, weight);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, progress)?;
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, false, progress)?;
+            if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
+                best = Some((rounded, s));
+            }
+        }
+        // Still bad where separations stayed violated (or in a few places):
+        // the plain fit again, the separations held as rows.
+        let held_pass = |b: &Rounded| b.collapsed + b.wound > 0 && (b.separations_violated > 0 || b.collapsed + b.wound <= STIFF_PASS_LIMIT);
+        if best.as_ref().is_some_and(|(b, _)| held_pass(b)) {
+            let fit = Fit::new(&self.elements, &stiff, 1.0);
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, true, progress)?;
             if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
                 best = Some((rounded, s));
             }
@@ -547,13 +573,13 @@ impl Quantizer {
                 let s_retry = s * factor;
                 let (x0, targets) = start(s_retry);
                 let rules = self.size_rules(&x0, s_retry);
-                let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, &rules, progress)?;
+                let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, &rules, false, progress)?;
                 if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
                     best = Some((rounded, s_retry));
                 }
             }
         }
-        let (Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_violated, .. }, s) =
+        let (Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_held, separations_violated, .. }, s) =
             best.expect("at least one pass");
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
@@ -599,6 +625,7 @@ impl Quantizer {
             batches,
             separation_moves,
             separations,
+            separations_held,
             separations_violated,
             curve_ends: self.curve_ends.len(),
             free_curve_ends: self.curve_ends.iter().filter(|end| end.free_at(s)).count(),
@@ -621,7 +648,10 @@ impl Quantizer {
     /// One greedy rounding of all forms with the fit `fit` (batches of
     /// [`BATCH_FRACTION`], each re-solved, separations restored), then
     /// [`Self::polish`], and where the map is still bad [`Self::uncollapse`]
-    /// and polish again, keeping the better.
+    /// and polish again, keeping the better. With `hold`, the relaxed map
+    /// first and every batch after it hold the separations they leave
+    /// violated ([`HeldApart`]).
+    #[allow(clippy::too_many_arguments)]
     fn round_and_polish(
         &self,
         fit: &Fit,
@@ -629,6 +659,7 @@ impl Quantizer {
         targets: &[[[f64; 2]; 2]],
         s: f64,
         rules: &SizeRules,
+        hold: bool,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<Rounded, QuantizeError> {
         let separations = &rules.separations;
@@ -638,6 +669,15 @@ impl Quantizer {
         let mut batches = 0;
         let mut separation_moves = 0;
         let mut system = None;
+        let mut held = HeldApart::default();
+        if hold {
+            for _ in 0..HOLD_ROUNDS {
+                if held.hold_violated(separations, &x) == 0 {
+                    break;
+                }
+                x = self.solve(fit, &order, &values, &x, targets, &held.list)?.0.x;
+            }
+        }
         for kind in [FormKind::Cone, FormKind::Point, FormKind::Translation] {
             loop {
                 let mut free: Vec<(f64, usize)> = (0..self.forms.len())
@@ -664,7 +704,7 @@ impl Quantizer {
                     }
                     order.truncate(before);
                     order.extend(&batch);
-                    let (solved, dependent) = self.solve(fit, &order, &values, &x, targets)?;
+                    let (solved, dependent) = self.solve(fit, &order, &values, &x, targets, &held.list)?;
                     // A candidate the others determine at a non-integer value (a
                     // dependency with coefficient 1/2 the kind order missed): round
                     // it first instead, so that it determines them.
@@ -688,6 +728,9 @@ impl Quantizer {
                 self.restore_parity(&mut solved, &dependent, &mut values, x0, targets)?;
                 separation_moves += self.separate(&mut solved, &mut values, x0, targets, separations)?;
                 x = solved.x.clone();
+                if hold {
+                    held.hold_violated(separations, &x);
+                }
                 // A candidate the batch's other forms already determine takes the
                 // value the solve gives it.
                 for i in dependent {
@@ -749,6 +792,7 @@ impl Quantizer {
             distortion,
             stiff_weight: fit.stiff_weight,
             separations: separations.list.len(),
+            separations_held: held.list.len(),
             separations_violated,
         })
     }
@@ -837,7 +881,8 @@ impl Quantizer {
     /// the change of its gap per unit change of every rounded integer comes
     /// from one adjoint solve (`K⁻¹ [c; 0]`, the multipliers), and
     /// the integers that widen it, closest to their seamless values first,
-    /// are tried moved by one, each re-solved with the same factorization. A
+    /// are tried moved by one (by two where the gap gains a half per unit),
+    /// each re-solved with the same factorization. A
     /// move is kept when every form stays integer and fewer separations stay
     /// violated; when none does, the cheapest move that mends one pair at
     /// the price of another is taken (at most [`SIDEWAYS_MOVES`], never back
@@ -873,8 +918,12 @@ impl Quantizer {
                     .filter_map(|&(form, row)| {
                         let gain = gap_gain[row];
                         let v = values[form]?;
-                        (gain.abs() > 0.5).then(|| {
-                            let step = if gain > 0.0 { 1 } else { -1 };
+                        // A gain of one half (a translation across a
+                        // half-turn seam: `f_g(P) + f_f(P) = 2 p`) widens
+                        // the gap by a line in two steps.
+                        (gain.abs() > 0.25).then(|| {
+                            let magnitude = if gain.abs() > 0.75 { 1 } else { 2 };
+                            let step = if gain > 0.0 { magnitude } else { -magnitude };
                             let cost = ((v + step) as f64 - self.forms[form].value(x0)).abs();
                             (cost, form, row, step)
                         })
@@ -1183,10 +1232,11 @@ impl Quantizer {
     }
 
     /// Factors the KKT of the seam rows, the rounded forms `order` (their
-    /// values in `values`) and the gauge pins each component still needs
-    /// (held at `x`'s values), and solves for the map closest to `targets`.
-    /// Also returns the forms of `order` left out because the earlier rows
-    /// determine them.
+    /// values in `values`), the gauge pins each component still needs
+    /// (held at `x`'s values) and the separations `held` (`x_hi - x_lo = 1`,
+    /// left out where the rows before determine them), and solves for the
+    /// map closest to `targets`. Also returns the forms of `order` left out
+    /// because the earlier rows determine them.
     fn solve(
         &self,
         fit: &Fit,
@@ -1194,6 +1244,7 @@ impl Quantizer {
         values: &[Option<i64>],
         x: &[f64],
         targets: &[[[f64; 2]; 2]],
+        held: &[Separation],
     ) -> Result<(RoundedSystem, Vec<usize>), QuantizeError> {
         let mut rows = self.seam_rows.clone();
         let mut rhs_rows = vec![0.0; rows.len()];
@@ -1213,6 +1264,10 @@ impl Quantizer {
             let unknown = self.pins[t / 2][t % 2];
             rows.push(vec![(unknown, 1)]);
             rhs_rows.push(x[unknown]);
+        }
+        for sep in held {
+            rows.push(vec![(sep.hi, 1), (sep.lo, -1)]);
+            rhs_rows.push(1.0);
         }
         let keep = independent_rows(&rows, self.n_unknowns);
         let n_seam = self.seam_rows.len();
@@ -1283,9 +1338,36 @@ struct Rounded {
     wound: usize,
     distortion: f64,
     stiff_weight: f64,
-    /// Separations of its grid size, and those `x` leaves violated.
+    /// Separations of its grid size, those held as rows ([`HeldApart`])
+    /// and those `x` leaves violated.
     separations: usize,
+    separations_held: usize,
     separations_violated: usize,
+}
+
+/// The separations held as rows `x_hi - x_lo = 1` of a pass's solves: each
+/// joins once a solve leaves its pair less than a grid line apart, integers
+/// or not, and stays (an active set that only grows: a pair pushed apart to
+/// one grid line would go back without its row). The rows are dropped by
+/// the solve once the rounded forms determine both unknowns.
+#[derive(Default)]
+struct HeldApart {
+    list: Vec<Separation>,
+    set: std::collections::HashSet<Separation>,
+}
+
+impl HeldApart {
+    /// Holds every separation of `separations` violated in `x` (less than a
+    /// grid line apart, integers or not); returns how many joined.
+    fn hold_violated(&mut self, separations: &Separations, x: &[f64]) -> usize {
+        let before = self.list.len();
+        for &sep in &separations.list {
+            if x[sep.hi] - x[sep.lo] < 1.0 - NEAR_INTEGER && self.set.insert(sep) {
+                self.list.push(sep);
+            }
+        }
+        self.list.len() - before
+    }
 }
 
 /// What quantization at one grid size keeps to beyond the forms.
