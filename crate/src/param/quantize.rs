@@ -41,7 +41,9 @@
 //! leaves the map bad, the whole rounding runs again with the faces within
 //! one grid unit of every singular point [`STIFF_WEIGHTS`] times stiffer, so
 //! the ring moves with its point; the pass with the fewest collapsed faces,
-//! then wound vertices, then the least fit distortion is kept. Where the
+//! then wound vertices, then the least fit distortion is kept, per
+//! component of the mesh (a game asset of many parts keeps, for each part,
+//! the pass that rounds it best). Where the
 //! map is still bad, one more pass holds the separations as rows
 //! ([`HeldApart`]): every pair a solve leaves less than a grid line apart is
 //! held exactly one apart in the solves that follow, the collapse
@@ -325,7 +327,9 @@ pub struct QuantizeReport {
     /// ARAP iterations kept after the rounding.
     pub arap_iterations: usize,
     /// Fit weight of the faces around singular points in the pass kept (1:
-    /// the plain fit; more where that folded or wound the map).
+    /// the plain fit; more where that folded or wound the map). Where
+    /// components of the mesh keep different passes, this and the other
+    /// figures of a pass are those of the pass kept for most faces.
     pub stiff_weight: f64,
     /// The rounded map had flipped triangles and the untangler removed them all.
     pub untangled: bool,
@@ -386,6 +390,19 @@ pub struct Quantizer {
     angle_sums: Vec<f64>,
     map_area: f64,
     distortion_before: f64,
+    /// The component of the mesh of every face, vertex, unknown and form
+    /// (components share no unknown: the passes' roundings of different
+    /// components join, [`Quantizer::keep_better`]).
+    components: Components,
+}
+
+/// Per face, vertex, unknown and form: its component of the mesh.
+struct Components {
+    n: usize,
+    face: Vec<usize>,
+    vertex: Vec<usize>,
+    unknown: Vec<usize>,
+    form: Vec<usize>,
 }
 
 impl Quantizer {
@@ -445,7 +462,21 @@ impl Quantizer {
         let angle_sums = corner_angle_sums(&faces, mesh.n_vertices(), |f| {
             [param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]
         });
+        let face: Vec<usize> = mesh.face_components().iter().map(|&c| c as usize).collect();
+        let mut unknown = vec![0usize; n_unknowns];
+        let mut vertex = vec![0usize; mesh.n_vertices()];
+        for (f, el) in elements.iter().enumerate() {
+            for &u in el.x.iter().flatten() {
+                unknown[u] = face[f];
+            }
+            for &v in &faces[f] {
+                vertex[v as usize] = face[f];
+            }
+        }
+        let form = forms.iter().map(|form| form.row.first().map_or(0, |&(u, _)| unknown[u])).collect();
+        let components = Components { n: mesh.n_components(), face, vertex, unknown, form };
         Ok(Quantizer {
+            components,
             seamless_areas,
             faces,
             angle_sums,
@@ -548,9 +579,7 @@ impl Quantizer {
             }
             let fit = Fit::new(&self.elements, &stiff, weight);
             let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, false, progress)?;
-            if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
-                best = Some((rounded, s));
-            }
+            self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
         }
         // Still bad where separations stayed violated (or in a few places):
         // the plain fit again, the separations held as rows.
@@ -558,9 +587,7 @@ impl Quantizer {
         if best.as_ref().is_some_and(|(b, _)| held_pass(b)) {
             let fit = Fit::new(&self.elements, &stiff, 1.0);
             let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, true, progress)?;
-            if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
-                best = Some((rounded, s));
-            }
+            self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
         }
         // A quad count only asks for about so many quads: where the map
         // still folds, nearby grid sizes round differently and often cleanly.
@@ -643,6 +670,78 @@ impl Quantizer {
             seconds: clock.lap(),
         };
         Ok(IntegerGridMap { uv, report })
+    }
+
+    /// Keeps the better of `best` and `candidate` (rounded at grid length
+    /// `s`) by (collapsed faces, wound vertices, fit distortion); of the
+    /// same grid length, the better per component of the mesh (they share
+    /// no unknown, so the roundings of two passes join).
+    fn keep_better(&self, best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64, targets: &[[[f64; 2]; 2]], separations: &Separations) {
+        let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
+        let Some((b, bs)) = best.as_mut() else {
+            *best = Some((candidate, s));
+            return;
+        };
+        if *bs != s || self.components.n == 1 {
+            if key(&candidate) < key(b) {
+                *best = Some((candidate, s));
+            }
+            return;
+        }
+        let (kb, kc) = (self.component_keys(&b.x, s, targets), self.component_keys(&candidate.x, s, targets));
+        let better: Vec<bool> = kb.iter().zip(&kc).map(|(b, c)| c < b).collect();
+        if better.iter().all(|&c| c) {
+            *best = Some((candidate, s));
+            return;
+        }
+        if !better.contains(&true) {
+            return;
+        }
+        // The pass figures (batches, moves, stiff weight, ...) are those of
+        // the pass kept for most faces.
+        if 2 * self.components.face.iter().filter(|&&c| better[c]).count() > self.components.face.len() {
+            (b.batches, b.separation_moves, b.moved_integers, b.arap_iterations, b.untangled, b.stiff_weight, b.separations_held) = (
+                candidate.batches,
+                candidate.separation_moves,
+                candidate.moved_integers,
+                candidate.arap_iterations,
+                candidate.untangled,
+                candidate.stiff_weight,
+                candidate.separations_held,
+            );
+        }
+        for (u, &c) in self.components.unknown.iter().enumerate() {
+            if better[c] {
+                b.x[u] = candidate.x[u];
+            }
+        }
+        for (i, &c) in self.components.form.iter().enumerate() {
+            if better[c] {
+                b.values[i] = candidate.values[i];
+            }
+        }
+        b.collapsed = (0..self.elements.len()).filter(|&f| self.collapsed(f, &b.x, s)).count();
+        b.wound = self.wound_vertices(&b.x).len();
+        b.distortion = self.fit_distortion(&b.x, targets);
+        b.separations_violated = separations.violated(&b.x, NEAR_INTEGER).len();
+    }
+
+    /// Per component of the mesh: (collapsed faces, wound vertices, fit distortion) of `x`.
+    fn component_keys(&self, x: &[f64], s: f64, targets: &[[[f64; 2]; 2]]) -> Vec<(usize, usize, f64)> {
+        let n = self.components.n;
+        let (mut collapsed, mut wound, mut sum, mut area) = (vec![0; n], vec![0; n], vec![0.0; n], vec![0.0; n]);
+        for (f, (el, t)) in self.elements.iter().zip(targets).enumerate() {
+            let c = self.components.face[f];
+            if self.collapsed(f, x, s) {
+                collapsed[c] += 1;
+            }
+            sum[c] += fit_error(el, x, t);
+            area[c] += el.area;
+        }
+        for v in self.wound_vertices(x) {
+            wound[self.components.vertex[v as usize]] += 1;
+        }
+        (0..n).map(|c| (collapsed[c], wound[c], sum[c] / area[c].max(f64::MIN_POSITIVE))).collect()
     }
 
     /// One greedy rounding of all forms with the fit `fit` (batches of
@@ -802,8 +901,7 @@ impl Quantizer {
     fn fit_distortion(&self, x: &[f64], targets: &[[[f64; 2]; 2]]) -> f64 {
         let (mut sum, mut area) = (0.0, 0.0);
         for (el, t) in self.elements.iter().zip(targets) {
-            let j = el.jacobian(x);
-            sum += el.area * (0..2).flat_map(|r| (0..2).map(move |c| (r, c))).map(|(r, c)| (j[r][c] - t[r][c]).powi(2)).sum::<f64>();
+            sum += fit_error(el, x, t);
             area += el.area;
         }
         sum / area
@@ -1459,6 +1557,12 @@ impl RoundedSystem {
         }
         Ok(x[..q.n_unknowns].to_vec())
     }
+}
+
+/// `A_f |J_f - T_f|^2`: the fit's error of element `el` in `x` against the target Jacobian `t`.
+fn fit_error(el: &Element, x: &[f64], t: &[[f64; 2]; 2]) -> f64 {
+    let j = el.jacobian(x);
+    el.area * (0..2).flat_map(|r| (0..2).map(move |c| (r, c))).map(|(r, c)| (j[r][c] - t[r][c]).powi(2)).sum::<f64>()
 }
 
 /// Per unknown: whether the integer-grid map makes it an integer: both
