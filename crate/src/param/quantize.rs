@@ -43,9 +43,9 @@
 //! the ring moves with its point; the pass with the fewest collapsed faces,
 //! then wound vertices, then the least fit distortion is kept, per
 //! component of the mesh (a game asset of many parts keeps, for each part,
-//! the pass that rounds it best). Where the
-//! map is still bad, one more pass holds the separations as rows
-//! ([`HeldApart`]): every pair a solve leaves less than a grid line apart is
+//! the pass that rounds it best). Where the map is still bad, one more pass
+//! holds the separations as rows ([`HeldApart`]): every pair a solve leaves
+//! less than a grid line apart is
 //! held exactly one apart in the solves that follow, the collapse
 //! constraints of Bommes et al. 2013 as an active set on the relaxed map,
 //! so that the rounding starts from a map that already keeps them apart
@@ -72,7 +72,7 @@ use super::seamless::{
     closest_rotation, curve_rotation, curve_wedge_pairs, elements, factored, seam_rows,
     stiffness_triplets, unknowns, RowSet,
 };
-use super::separation::{Separation, Separations};
+use super::separation::{HeldApart, Separation, Separations};
 use super::untangle::{untangle, UntangleOptions};
 use super::{ParamError, Parametrization};
 use crate::clock::Stopwatch;
@@ -771,7 +771,7 @@ impl Quantizer {
         let mut held = HeldApart::default();
         if hold {
             for _ in 0..HOLD_ROUNDS {
-                if held.hold_violated(separations, &x) == 0 {
+                if held.hold_violated(separations, &x, NEAR_INTEGER) == 0 {
                     break;
                 }
                 x = self.solve(fit, &order, &values, &x, targets, &held.list)?.0.x;
@@ -828,7 +828,7 @@ impl Quantizer {
                 separation_moves += self.separate(&mut solved, &mut values, x0, targets, separations)?;
                 x = solved.x.clone();
                 if hold {
-                    held.hold_violated(separations, &x);
+                    held.hold_violated(separations, &x, NEAR_INTEGER);
                 }
                 // A candidate the batch's other forms already determine takes the
                 // value the solve gives it.
@@ -1441,31 +1441,6 @@ struct Rounded {
     separations: usize,
     separations_held: usize,
     separations_violated: usize,
-}
-
-/// The separations held as rows `x_hi - x_lo = 1` of a pass's solves: each
-/// joins once a solve leaves its pair less than a grid line apart, integers
-/// or not, and stays (an active set that only grows: a pair pushed apart to
-/// one grid line would go back without its row). The rows are dropped by
-/// the solve once the rounded forms determine both unknowns.
-#[derive(Default)]
-struct HeldApart {
-    list: Vec<Separation>,
-    set: std::collections::HashSet<Separation>,
-}
-
-impl HeldApart {
-    /// Holds every separation of `separations` violated in `x` (less than a
-    /// grid line apart, integers or not); returns how many joined.
-    fn hold_violated(&mut self, separations: &Separations, x: &[f64]) -> usize {
-        let before = self.list.len();
-        for &sep in &separations.list {
-            if x[sep.hi] - x[sep.lo] < 1.0 - NEAR_INTEGER && self.set.insert(sep) {
-                self.list.push(sep);
-            }
-        }
-        self.list.len() - before
-    }
 }
 
 /// What quantization at one grid size keeps to beyond the forms.

@@ -23,6 +23,9 @@
 //! (which they would collapse, whatever the direction); or when one is an
 //! isoline and the other lies between two of its vertices along it (a cone
 //! a fraction of a cell from a feature curve: the CAD cylinder's rim).
+//!
+//! [`HeldApart`] is the active set of a pass that holds violated pairs as
+//! rows of its solves.
 
 use super::element::{Element, NearWedges};
 use std::collections::HashSet;
@@ -197,6 +200,32 @@ impl Separations {
     pub fn violated(&self, x: &[f64], near: f64) -> Vec<Separation> {
         let integer = |y: f64| (y - y.round()).abs() < near;
         self.list.iter().copied().filter(|s| integer(x[s.lo]) && integer(x[s.hi]) && x[s.hi] - x[s.lo] < 1.0 - near).collect()
+    }
+}
+
+/// The separations held as rows `x_hi - x_lo = 1` of a pass's solves: each
+/// joins once a solve leaves its pair less than a grid line apart, integers
+/// or not, and stays (an active set that only grows: a pair pushed apart to
+/// one grid line would go back without its row). The rows are dropped by
+/// the solve once the rounded forms determine both unknowns.
+#[derive(Default)]
+pub(super) struct HeldApart {
+    pub list: Vec<Separation>,
+    set: HashSet<Separation>,
+}
+
+impl HeldApart {
+    /// Holds every separation of `separations` violated in `x` (less than a
+    /// grid line apart by more than `near`, integers or not); returns how
+    /// many joined.
+    pub fn hold_violated(&mut self, separations: &Separations, x: &[f64], near: f64) -> usize {
+        let before = self.list.len();
+        for &sep in &separations.list {
+            if x[sep.hi] - x[sep.lo] < 1.0 - near && self.set.insert(sep) {
+                self.list.push(sep);
+            }
+        }
+        self.list.len() - before
     }
 }
 
