@@ -56,7 +56,9 @@
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
 //! batch (the rows change; about ten batches), and up to four passes where
 //! the plain fit leaves the map bad (the held pass: up to [`HOLD_ROUNDS`]
-//! more factorizations before its first batch). With that factorization:
+//! more factorizations before its first batch), five on a mesh of several
+//! parts (one whose batches take a share of every part's forms, so that
+//! each rounds as it would alone). With that factorization:
 //! one adjoint solve per violated separation and one solve per move tried
 //! (at most [`SEPARATION_TRIALS`] per batch, fewer on large meshes:
 //! [`FULL_BUDGET_FACES`]); after the last batch, one
@@ -578,7 +580,7 @@ impl Quantizer {
                 break;
             }
             let fit = Fit::new(&self.elements, &stiff, weight);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, false, progress)?;
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass::default(), progress)?;
             self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
         }
         // Still bad where separations stayed violated (or in a few places):
@@ -586,7 +588,15 @@ impl Quantizer {
         let held_pass = |b: &Rounded| b.collapsed + b.wound > 0 && (b.separations_violated > 0 || b.collapsed + b.wound <= STIFF_PASS_LIMIT);
         if best.as_ref().is_some_and(|(b, _)| held_pass(b)) {
             let fit = Fit::new(&self.elements, &stiff, 1.0);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, true, progress)?;
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, ..Pass::default() }, progress)?;
+            self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
+        }
+        // Of several parts, each rounded as it would be alone (a small part
+        // whose forms all fall into one batch of the whole rounds them
+        // without a solve between): the parts it mends join.
+        if self.components.n > 1 && best.as_ref().is_some_and(|(b, _)| b.collapsed + b.wound > 0) {
+            let fit = Fit::new(&self.elements, &stiff, 1.0);
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { per_component: true, ..Pass::default() }, progress)?;
             self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
         }
         // A quad count only asks for about so many quads: where the map
@@ -600,7 +610,7 @@ impl Quantizer {
                 let s_retry = s * factor;
                 let (x0, targets) = start(s_retry);
                 let rules = self.size_rules(&x0, s_retry);
-                let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, &rules, false, progress)?;
+                let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, &rules, Pass::default(), progress)?;
                 if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
                     best = Some((rounded, s_retry));
                 }
@@ -747,9 +757,10 @@ impl Quantizer {
     /// One greedy rounding of all forms with the fit `fit` (batches of
     /// [`BATCH_FRACTION`], each re-solved, separations restored), then
     /// [`Self::polish`], and where the map is still bad [`Self::uncollapse`]
-    /// and polish again, keeping the better. With `hold`, the relaxed map
-    /// first and every batch after it hold the separations they leave
-    /// violated ([`HeldApart`]).
+    /// and polish again, keeping the better. With `pass.hold`, the relaxed
+    /// map first and every batch after it hold the separations they leave
+    /// violated ([`HeldApart`]); with `pass.per_component`, a batch takes
+    /// [`BATCH_FRACTION`] of every component's remaining forms.
     #[allow(clippy::too_many_arguments)]
     fn round_and_polish(
         &self,
@@ -758,7 +769,7 @@ impl Quantizer {
         targets: &[[[f64; 2]; 2]],
         s: f64,
         rules: &SizeRules,
-        hold: bool,
+        pass: Pass,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<Rounded, QuantizeError> {
         let separations = &rules.separations;
@@ -769,7 +780,7 @@ impl Quantizer {
         let mut separation_moves = 0;
         let mut system = None;
         let mut held = HeldApart::default();
-        if hold {
+        if pass.hold {
             for _ in 0..HOLD_ROUNDS {
                 if held.hold_violated(separations, &x, NEAR_INTEGER) == 0 {
                     break;
@@ -787,11 +798,25 @@ impl Quantizer {
                     break;
                 }
                 free.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                let near = free.iter().filter(|f| f.0 < NEAR_INTEGER).count();
-                let take = ((free.len() as f64 * BATCH_FRACTION).ceil() as usize)
-                    .max(near)
-                    .min(free.len());
-                let mut batch: Vec<usize> = free[..take].iter().map(|f| f.1).collect();
+                // The nearest share of the forms (of every component's,
+                // `per_component`), and every form already near an integer.
+                let share = |n: usize| (n as f64 * BATCH_FRACTION).ceil() as usize;
+                let mut quota = vec![0usize; if pass.per_component { self.components.n } else { 1 }];
+                let group = |i: usize| if pass.per_component { self.components.form[i] } else { 0 };
+                for f in &free {
+                    quota[group(f.1)] += 1;
+                }
+                quota.iter_mut().for_each(|q| *q = share(*q));
+                let mut batch: Vec<usize> = free
+                    .iter()
+                    .filter(|f| {
+                        let q = &mut quota[group(f.1)];
+                        let take = f.0 < NEAR_INTEGER || *q > 0;
+                        *q = q.saturating_sub(1);
+                        take
+                    })
+                    .map(|f| f.1)
+                    .collect();
                 let before = order.len();
                 let mut retries = 0;
                 let (solved, dependent) = loop {
@@ -827,7 +852,7 @@ impl Quantizer {
                 self.restore_parity(&mut solved, &dependent, &mut values, x0, targets)?;
                 separation_moves += self.separate(&mut solved, &mut values, x0, targets, separations)?;
                 x = solved.x.clone();
-                if hold {
+                if pass.hold {
                     held.hold_violated(separations, &x, NEAR_INTEGER);
                 }
                 // A candidate the batch's other forms already determine takes the
@@ -1441,6 +1466,16 @@ struct Rounded {
     separations: usize,
     separations_held: usize,
     separations_violated: usize,
+}
+
+/// How a pass of [`Quantizer::round_and_polish`] rounds: holding the
+/// separations it leaves violated as rows ([`HeldApart`]), and taking each
+/// batch from every component's forms alike (else from all forms by
+/// distance to their integers).
+#[derive(Clone, Copy, Default)]
+struct Pass {
+    hold: bool,
+    per_component: bool,
 }
 
 /// What quantization at one grid size keeps to beyond the forms.
