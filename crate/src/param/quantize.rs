@@ -45,9 +45,9 @@
 //! component of the mesh (a game asset of many parts keeps, for each part,
 //! the pass that rounds it best). Where the map is still bad, one more pass
 //! holds the separations as rows ([`HeldApart`]): every pair a solve leaves
-//! less than a grid line apart is
-//! held exactly one apart in the solves that follow, the collapse
-//! constraints of Bommes et al. 2013 as an active set on the relaxed map,
+//! less than a grid line apart is held exactly one apart in the solves that
+//! follow, the collapse constraints of Bommes et al. 2013 as an active set
+//! on the relaxed map,
 //! so that the rounding starts from a map that already keeps them apart
 //! (where a cell is wider than a part of the surface, a plank or a box
 //! thinner than a cell, the moves of [`Quantizer::separate`] one integer
@@ -569,10 +569,6 @@ impl Quantizer {
         // again with the faces around singular points stiffer; the best is kept.
         let stiff = self.stiff_faces(&x0);
         let rules = self.size_rules(&x0, s);
-        // Flipped or collapsed faces leave holes in the quad mesh; a cell
-        // the map winds around is closed with quads (an extra singular
-        // vertex): fewer of the first, then of the second, count first.
-        let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
         let mut best: Option<(Rounded, f64)> = None;
         for (pass, &weight) in STIFF_WEIGHTS.iter().enumerate() {
             let settled = |b: &Rounded| b.collapsed + b.wound == 0 || b.collapsed + b.wound > STIFF_PASS_LIMIT;
@@ -611,9 +607,7 @@ impl Quantizer {
                 let (x0, targets) = start(s_retry);
                 let rules = self.size_rules(&x0, s_retry);
                 let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, &rules, Pass::default(), progress)?;
-                if best.as_ref().is_none_or(|(b, _)| key(&rounded) < key(b)) {
-                    best = Some((rounded, s_retry));
-                }
+                self.keep_better(&mut best, rounded, s_retry, &targets, &rules.separations);
             }
         }
         let (Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_held, separations_violated, .. }, s) =
@@ -685,7 +679,10 @@ impl Quantizer {
     /// Keeps the better of `best` and `candidate` (rounded at grid length
     /// `s`) by (collapsed faces, wound vertices, fit distortion); of the
     /// same grid length, the better per component of the mesh (they share
-    /// no unknown, so the roundings of two passes join).
+    /// no unknown, so the roundings of two passes join). Flipped or
+    /// collapsed faces leave holes in the quad mesh; a cell the map winds
+    /// around is closed with quads (an extra singular vertex): fewer of the
+    /// first, then of the second, count first.
     fn keep_better(&self, best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64, targets: &[[[f64; 2]; 2]], separations: &Separations) {
         let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
         let Some((b, bs)) = best.as_mut() else {
@@ -730,10 +727,14 @@ impl Quantizer {
                 b.values[i] = candidate.values[i];
             }
         }
-        b.collapsed = (0..self.elements.len()).filter(|&f| self.collapsed(f, &b.x, s)).count();
-        b.wound = self.wound_vertices(&b.x).len();
-        b.distortion = self.fit_distortion(&b.x, targets);
-        b.separations_violated = separations.violated(&b.x, NEAR_INTEGER).len();
+        (b.collapsed, b.wound, b.distortion, b.separations_violated) = self.assess(&b.x, s, targets, separations);
+    }
+
+    /// How good the rounded map `x` (grid length `s`) is: (collapsed faces,
+    /// wound vertices, fit distortion, violated separations).
+    fn assess(&self, x: &[f64], s: f64, targets: &[[[f64; 2]; 2]], separations: &Separations) -> (usize, usize, f64, usize) {
+        let collapsed = (0..self.elements.len()).filter(|&f| self.collapsed(f, x, s)).count();
+        (collapsed, self.wound_vertices(x).len(), self.fit_distortion(x, targets), separations.violated(x, NEAR_INTEGER).len())
     }
 
     /// Per component of the mesh: (collapsed faces, wound vertices, fit distortion) of `x`.
@@ -899,10 +900,7 @@ impl Quantizer {
                 }
             }
         }
-        let collapsed = (0..self.elements.len()).filter(|&f| self.collapsed(f, &x, s)).count();
-        let wound = self.wound_vertices(&x).len();
-        let distortion = self.fit_distortion(&x, targets);
-        let separations_violated = separations.violated(&x, NEAR_INTEGER).len();
+        let (collapsed, wound, distortion, separations_violated) = self.assess(&x, s, targets, separations);
         Ok(Rounded {
             x,
             values,
