@@ -41,24 +41,26 @@
 //! leaves the map bad, the whole rounding runs again with the faces within
 //! one grid unit of every singular point [`STIFF_WEIGHTS`] times stiffer, so
 //! the ring moves with its point; the pass with the fewest collapsed faces,
-//! then wound vertices, then the least fit distortion is kept, per
-//! component of the mesh (a game asset of many parts keeps, for each part,
-//! the pass that rounds it best). Where the map is still bad, one more pass
-//! holds the separations as rows ([`HeldApart`]): every pair a solve leaves
-//! less than a grid line apart is held exactly one apart in the solves that
-//! follow, the collapse constraints of Bommes et al. 2013 as an active set
-//! on the relaxed map,
+//! then wound vertices, then the least fit distortion is kept. Where the map
+//! is still bad, one more pass holds the separations as rows
+//! ([`HeldApart`]): every pair a solve leaves less than a grid line apart is
+//! held exactly one apart in the solves that follow, the collapse
+//! constraints of Bommes et al. 2013 as an active set on the relaxed map,
 //! so that the rounding starts from a map that already keeps them apart
 //! (where a cell is wider than a part of the surface, a plank or a box
 //! thinner than a cell, the moves of [`Quantizer::separate`] one integer
 //! at a time cannot undo the collapse: each breaks the neighbouring pairs).
+//! Where it is still bad and a quad count was asked, grids a few percent
+//! larger and smaller ([`RETRY_GRID_FACTORS`]).
+//!
+//! A mesh of several parts (components) is quantized one part at a time
+//! ([`parts`]): they share no unknown, so each rounds as it would alone,
+//! with its own passes, and a pass costs only the part it re-runs.
 //!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
-//! batch (the rows change; about ten batches), and up to four passes where
+//! batch (the rows change; about ten batches), and up to seven passes where
 //! the plain fit leaves the map bad (the held pass: up to [`HOLD_ROUNDS`]
-//! more factorizations before its first batch), five on a mesh of several
-//! parts (one whose batches take a share of every part's forms, so that
-//! each rounds as it would alone). With that factorization:
+//! more factorizations before its first batch). With that factorization:
 //! one adjoint solve per violated separation and one solve per move tried
 //! (at most [`SEPARATION_TRIALS`] per batch, fewer on large meshes:
 //! [`FULL_BUDGET_FACES`]); after the last batch, one
@@ -77,6 +79,8 @@ use super::seamless::{
 use super::separation::{HeldApart, Separation, Separations};
 use super::untangle::{untangle, UntangleOptions};
 use super::{ParamError, Parametrization};
+
+mod parts;
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
 use crate::features::CutMesh;
@@ -84,6 +88,7 @@ use crate::linalg::{
     constraint_values, independent_rows, Kkt, LdltSolver, NullSpaceProjector, Triplet,
 };
 use crate::mesh::{TriMesh, UnionFind};
+use parts::Part;
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_4, PI};
 use std::fmt;
@@ -329,9 +334,9 @@ pub struct QuantizeReport {
     /// ARAP iterations kept after the rounding.
     pub arap_iterations: usize,
     /// Fit weight of the faces around singular points in the pass kept (1:
-    /// the plain fit; more where that folded or wound the map). Where
-    /// components of the mesh keep different passes, this and the other
-    /// figures of a pass are those of the pass kept for most faces.
+    /// the plain fit; more where that folded or wound the map). On a mesh of
+    /// several parts, that of the part with the largest map area (counts
+    /// are summed over the parts).
     pub stiff_weight: f64,
     /// The rounded map had flipped triangles and the untangler removed them all.
     pub untangled: bool,
@@ -392,19 +397,10 @@ pub struct Quantizer {
     angle_sums: Vec<f64>,
     map_area: f64,
     distortion_before: f64,
-    /// The component of the mesh of every face, vertex, unknown and form
-    /// (components share no unknown: the passes' roundings of different
-    /// components join, [`Quantizer::keep_better`]).
-    components: Components,
-}
-
-/// Per face, vertex, unknown and form: its component of the mesh.
-struct Components {
-    n: usize,
-    face: Vec<usize>,
-    vertex: Vec<usize>,
-    unknown: Vec<usize>,
-    form: Vec<usize>,
+    /// On a mesh of several components: each as a quantizer of its own
+    /// (they share no unknown, and each is rounded as it would be alone:
+    /// [`parts`]); empty on a mesh of one component.
+    parts: Vec<Part>,
 }
 
 impl Quantizer {
@@ -464,21 +460,8 @@ impl Quantizer {
         let angle_sums = corner_angle_sums(&faces, mesh.n_vertices(), |f| {
             [param.uv[3 * f], param.uv[3 * f + 1], param.uv[3 * f + 2]]
         });
-        let face: Vec<usize> = mesh.face_components().iter().map(|&c| c as usize).collect();
-        let mut unknown = vec![0usize; n_unknowns];
-        let mut vertex = vec![0usize; mesh.n_vertices()];
-        for (f, el) in elements.iter().enumerate() {
-            for &u in el.x.iter().flatten() {
-                unknown[u] = face[f];
-            }
-            for &v in &faces[f] {
-                vertex[v as usize] = face[f];
-            }
-        }
-        let form = forms.iter().map(|form| form.row.first().map_or(0, |&(u, _)| unknown[u])).collect();
-        let components = Components { n: mesh.n_components(), face, vertex, unknown, form };
-        Ok(Quantizer {
-            components,
+        let mut quantizer = Quantizer {
+            parts: Vec::new(),
             seamless_areas,
             faces,
             angle_sums,
@@ -496,7 +479,12 @@ impl Quantizer {
             seamless,
             map_area,
             distortion_before: metrics::distortion(mesh, &param.uv),
-        })
+        };
+        if mesh.n_components() > 1 {
+            let face_part: Vec<usize> = mesh.face_components().iter().map(|&c| c as usize).collect();
+            quantizer.parts = Part::split(&quantizer, &face_part, mesh.n_components());
+        }
+        Ok(quantizer)
     }
 
     /// Faces within [`STIFF_RADIUS`] grid units (in the seamless map `x0`,
@@ -537,7 +525,8 @@ impl Quantizer {
     /// `report.flipped` says whether the map is still free of flips. For
     /// [`GridSize::Quads`] the grid length may be a few percent off
     /// `sqrt(area / n)` where that rounds with fewer flips
-    /// ([`RETRY_GRID_FACTORS`]); `report.grid_size` is the one used.
+    /// ([`RETRY_GRID_FACTORS`]); `report.grid_size` is the one used (on a mesh
+    /// of several parts, each may keep its own: that of the largest part).
     pub fn quantize(
         &self,
         mesh: &TriMesh,
@@ -557,61 +546,13 @@ impl Quantizer {
     ) -> Result<IntegerGridMap, QuantizeError> {
         let mut clock = Stopwatch::start();
         let s = self.grid_length(size)?;
-        // The seamless map in units of the grid length `s`, and its Jacobians
-        // (the fit's targets).
-        let start = |s: f64| {
-            let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
-            let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
-            (x0, targets)
+        let retry = matches!(size, GridSize::Quads(_));
+        let (rounded, s) = if self.parts.is_empty() {
+            self.round(s, retry, options, progress)?
+        } else {
+            self.round_parts(s, retry, options, progress)?
         };
-        let (x0, targets) = start(s);
-        // Rounded with the uniform fit, and where that leaves the map bad,
-        // again with the faces around singular points stiffer; the best is kept.
-        let stiff = self.stiff_faces(&x0);
-        let rules = self.size_rules(&x0, s);
-        let mut best: Option<(Rounded, f64)> = None;
-        for (pass, &weight) in STIFF_WEIGHTS.iter().enumerate() {
-            let settled = |b: &Rounded| b.collapsed + b.wound == 0 || b.collapsed + b.wound > STIFF_PASS_LIMIT;
-            if pass > 0 && (best.as_ref().is_some_and(|(b, _)| settled(b)) || !stiff.contains(&true)) {
-                break;
-            }
-            let fit = Fit::new(&self.elements, &stiff, weight);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass::default(), progress)?;
-            self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
-        }
-        // Still bad where separations stayed violated (or in a few places):
-        // the plain fit again, the separations held as rows.
-        let held_pass = |b: &Rounded| b.collapsed + b.wound > 0 && (b.separations_violated > 0 || b.collapsed + b.wound <= STIFF_PASS_LIMIT);
-        if best.as_ref().is_some_and(|(b, _)| held_pass(b)) {
-            let fit = Fit::new(&self.elements, &stiff, 1.0);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, ..Pass::default() }, progress)?;
-            self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
-        }
-        // Of several parts, each rounded as it would be alone (a small part
-        // whose forms all fall into one batch of the whole rounds them
-        // without a solve between): the parts it mends join.
-        if self.components.n > 1 && best.as_ref().is_some_and(|(b, _)| b.collapsed + b.wound > 0) {
-            let fit = Fit::new(&self.elements, &stiff, 1.0);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { per_component: true, ..Pass::default() }, progress)?;
-            self.keep_better(&mut best, rounded, s, &targets, &rules.separations);
-        }
-        // A quad count only asks for about so many quads: where the map
-        // still folds, nearby grid sizes round differently and often cleanly.
-        if let GridSize::Quads(_) = size {
-            let fit = Fit::new(&self.elements, &stiff, 1.0);
-            for factor in RETRY_GRID_FACTORS {
-                if best.as_ref().is_some_and(|(b, _)| b.collapsed == 0 && (b.wound == 0 || !options.retry_wound)) {
-                    break;
-                }
-                let s_retry = s * factor;
-                let (x0, targets) = start(s_retry);
-                let rules = self.size_rules(&x0, s_retry);
-                let rounded = self.round_and_polish(&fit, &x0, &targets, s_retry, &rules, Pass::default(), progress)?;
-                self.keep_better(&mut best, rounded, s_retry, &targets, &rules.separations);
-            }
-        }
-        let (Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_held, separations_violated, .. }, s) =
-            best.expect("at least one pass");
+        let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_held, separations_violated, free_curve_ends, .. } = rounded;
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
             if let (FormKind::Cone | FormKind::Point, [(i, 1)], Some(v)) =
@@ -659,7 +600,7 @@ impl Quantizer {
             separations_held,
             separations_violated,
             curve_ends: self.curve_ends.len(),
-            free_curve_ends: self.curve_ends.iter().filter(|end| end.free_at(s)).count(),
+            free_curve_ends,
             moved_integers,
             arap_iterations,
             stiff_weight,
@@ -676,58 +617,102 @@ impl Quantizer {
         Ok(IntegerGridMap { uv, report })
     }
 
-    /// Keeps the better of `best` and `candidate` (rounded at grid length
-    /// `s`) by (collapsed faces, wound vertices, fit distortion); of the
-    /// same grid length, the better per component of the mesh (they share
-    /// no unknown, so the roundings of two passes join). Flipped or
-    /// collapsed faces leave holes in the quad mesh; a cell the map winds
-    /// around is closed with quads (an extra singular vertex): fewer of the
-    /// first, then of the second, count first.
-    fn keep_better(&self, best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64, targets: &[[[f64; 2]; 2]], separations: &Separations) {
-        let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
-        let Some((b, bs)) = best.as_mut() else {
-            *best = Some((candidate, s));
-            return;
+    /// The rounding at grid length `s` kept of the passes: the plain fit;
+    /// where that leaves the map bad, the faces around singular points
+    /// stiffer ([`STIFF_WEIGHTS`]); where it is still bad, the separations
+    /// held ([`HeldApart`]); then, with `retry` (a quad count asked, not a
+    /// length), nearby grid lengths ([`RETRY_GRID_FACTORS`]), holding the
+    /// separations where the best map so far is the held pass's. Returns the map kept and its grid length.
+    fn round(&self, s: f64, retry: bool, options: &QuantizeOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<(Rounded, f64), QuantizeError> {
+        // The seamless map in units of the grid length `s`, and its Jacobians
+        // (the fit's targets).
+        let start = |s: f64| {
+            let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
+            let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
+            (x0, targets)
         };
-        if *bs != s || self.components.n == 1 {
-            if key(&candidate) < key(b) {
-                *best = Some((candidate, s));
+        let (x0, targets) = start(s);
+        let stiff = self.stiff_faces(&x0);
+        let rules = self.size_rules(&x0, s);
+        let mut best: Option<(Rounded, f64)> = None;
+        for (pass, &weight) in STIFF_WEIGHTS.iter().enumerate() {
+            let settled = |b: &Rounded| b.collapsed + b.wound == 0 || b.collapsed + b.wound > STIFF_PASS_LIMIT;
+            if pass > 0 && (best.as_ref().is_some_and(|(b, _)| settled(b)) || !stiff.contains(&true)) {
+                break;
             }
-            return;
+            let fit = Fit::new(&self.elements, &stiff, weight);
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass::default(), progress)?;
+            keep_better(&mut best, rounded, s);
         }
-        let (kb, kc) = (self.component_keys(&b.x, s, targets), self.component_keys(&candidate.x, s, targets));
-        let better: Vec<bool> = kb.iter().zip(&kc).map(|(b, c)| c < b).collect();
-        if better.iter().all(|&c| c) {
-            *best = Some((candidate, s));
-            return;
+        // Still bad where separations stayed violated (or in a few places):
+        // the plain fit again, the separations held as rows.
+        let held_pass = |b: &Rounded| b.collapsed + b.wound > 0 && (b.separations_violated > 0 || b.collapsed + b.wound <= STIFF_PASS_LIMIT);
+        if best.as_ref().is_some_and(|(b, _)| held_pass(b)) {
+            let fit = Fit::new(&self.elements, &stiff, 1.0);
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true }, progress)?;
+            keep_better(&mut best, rounded, s);
         }
-        if !better.contains(&true) {
-            return;
-        }
-        // The pass figures (batches, moves, stiff weight, ...) are those of
-        // the pass kept for most faces.
-        if 2 * self.components.face.iter().filter(|&&c| better[c]).count() > self.components.face.len() {
-            (b.batches, b.separation_moves, b.moved_integers, b.arap_iterations, b.untangled, b.stiff_weight, b.separations_held) = (
-                candidate.batches,
-                candidate.separation_moves,
-                candidate.moved_integers,
-                candidate.arap_iterations,
-                candidate.untangled,
-                candidate.stiff_weight,
-                candidate.separations_held,
-            );
-        }
-        for (u, &c) in self.components.unknown.iter().enumerate() {
-            if better[c] {
-                b.x[u] = candidate.x[u];
+        // A quad count only asks for about so many quads: where the map
+        // still folds, nearby grid lengths round differently and often
+        // cleanly (holding the separations where the held pass did best).
+        let mut fit = None;
+        for factor in RETRY_GRID_FACTORS.into_iter().filter(|_| retry) {
+            if best.as_ref().is_some_and(|(b, _)| b.collapsed == 0 && (b.wound == 0 || !options.retry_wound)) {
+                break;
             }
+            let hold = best.as_ref().is_some_and(|(b, _)| b.separations_held > 0);
+            let s_retry = s * factor;
+            let (x0, targets) = start(s_retry);
+            let rules = self.size_rules(&x0, s_retry);
+            let fit = fit.get_or_insert_with(|| Fit::new(&self.elements, &stiff, 1.0));
+            let rounded = self.round_and_polish(fit, &x0, &targets, s_retry, &rules, Pass { hold }, progress)?;
+            keep_better(&mut best, rounded, s_retry);
         }
-        for (i, &c) in self.components.form.iter().enumerate() {
-            if better[c] {
-                b.values[i] = candidate.values[i];
+        Ok(best.expect("at least one pass"))
+    }
+
+    /// [`Self::round`] of every part on its own, joined: the unknowns and
+    /// forms of each part from its rounding, the counts summed. A part may
+    /// keep a retried grid length of its own; the length returned is that
+    /// of the part with the largest map area.
+    fn round_parts(&self, s: f64, retry: bool, options: &QuantizeOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<(Rounded, f64), QuantizeError> {
+        let mut joined = Rounded {
+            x: vec![0.0; self.n_unknowns],
+            values: vec![None; self.forms.len()],
+            stiff_weight: 1.0,
+            ..Rounded::default()
+        };
+        let (mut s_joined, mut largest, mut rounded_forms) = (s, 0.0, 0);
+        for part in &self.parts {
+            let q = &part.quantizer;
+            let mut part_progress = |done: usize, _: usize| progress(rounded_forms + done, self.forms.len());
+            let (r, s_part) = q.round(s, retry, options, &mut part_progress)?;
+            rounded_forms += q.forms.len();
+            for (&u, &v) in part.unknown.iter().zip(&r.x) {
+                joined.x[u] = v;
             }
+            for (&i, &v) in part.form.iter().zip(&r.values) {
+                joined.values[i] = v;
+            }
+            if q.map_area > largest {
+                (largest, s_joined, joined.stiff_weight) = (q.map_area, s_part, r.stiff_weight);
+            }
+            joined.batches += r.batches;
+            joined.separation_moves += r.separation_moves;
+            joined.moved_integers += r.moved_integers;
+            joined.arap_iterations = joined.arap_iterations.max(r.arap_iterations);
+            joined.untangled |= r.untangled;
+            joined.collapsed += r.collapsed;
+            joined.wound += r.wound;
+            joined.distortion += r.distortion * q.map_area / self.map_area;
+            joined.separations += r.separations;
+            joined.separations_held += r.separations_held;
+            joined.separations_violated += r.separations_violated;
+            joined.free_curve_ends += r.free_curve_ends;
         }
-        (b.collapsed, b.wound, b.distortion, b.separations_violated) = self.assess(&b.x, s, targets, separations);
+        // Untangled: some part's flips were all removed and no part has any left.
+        joined.untangled &= joined.collapsed == 0;
+        Ok((joined, s_joined))
     }
 
     /// How good the rounded map `x` (grid length `s`) is: (collapsed faces,
@@ -737,31 +722,12 @@ impl Quantizer {
         (collapsed, self.wound_vertices(x).len(), self.fit_distortion(x, targets), separations.violated(x, NEAR_INTEGER).len())
     }
 
-    /// Per component of the mesh: (collapsed faces, wound vertices, fit distortion) of `x`.
-    fn component_keys(&self, x: &[f64], s: f64, targets: &[[[f64; 2]; 2]]) -> Vec<(usize, usize, f64)> {
-        let n = self.components.n;
-        let (mut collapsed, mut wound, mut sum, mut area) = (vec![0; n], vec![0; n], vec![0.0; n], vec![0.0; n]);
-        for (f, (el, t)) in self.elements.iter().zip(targets).enumerate() {
-            let c = self.components.face[f];
-            if self.collapsed(f, x, s) {
-                collapsed[c] += 1;
-            }
-            sum[c] += fit_error(el, x, t);
-            area[c] += el.area;
-        }
-        for v in self.wound_vertices(x) {
-            wound[self.components.vertex[v as usize]] += 1;
-        }
-        (0..n).map(|c| (collapsed[c], wound[c], sum[c] / area[c].max(f64::MIN_POSITIVE))).collect()
-    }
-
     /// One greedy rounding of all forms with the fit `fit` (batches of
     /// [`BATCH_FRACTION`], each re-solved, separations restored), then
     /// [`Self::polish`], and where the map is still bad [`Self::uncollapse`]
     /// and polish again, keeping the better. With `pass.hold`, the relaxed
     /// map first and every batch after it hold the separations they leave
-    /// violated ([`HeldApart`]); with `pass.per_component`, a batch takes
-    /// [`BATCH_FRACTION`] of every component's remaining forms.
+    /// violated ([`HeldApart`]).
     #[allow(clippy::too_many_arguments)]
     fn round_and_polish(
         &self,
@@ -799,25 +765,11 @@ impl Quantizer {
                     break;
                 }
                 free.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                // The nearest share of the forms (of every component's,
-                // `per_component`), and every form already near an integer.
-                let share = |n: usize| (n as f64 * BATCH_FRACTION).ceil() as usize;
-                let mut quota = vec![0usize; if pass.per_component { self.components.n } else { 1 }];
-                let group = |i: usize| if pass.per_component { self.components.form[i] } else { 0 };
-                for f in &free {
-                    quota[group(f.1)] += 1;
-                }
-                quota.iter_mut().for_each(|q| *q = share(*q));
-                let mut batch: Vec<usize> = free
-                    .iter()
-                    .filter(|f| {
-                        let q = &mut quota[group(f.1)];
-                        let take = f.0 < NEAR_INTEGER || *q > 0;
-                        *q = q.saturating_sub(1);
-                        take
-                    })
-                    .map(|f| f.1)
-                    .collect();
+                // The nearest share of the forms, and every form already near
+                // an integer.
+                let near = free.iter().filter(|f| f.0 < NEAR_INTEGER).count();
+                let take = ((free.len() as f64 * BATCH_FRACTION).ceil() as usize).max(near).min(free.len());
+                let mut batch: Vec<usize> = free[..take].iter().map(|f| f.1).collect();
                 let before = order.len();
                 let mut retries = 0;
                 let (solved, dependent) = loop {
@@ -916,6 +868,7 @@ impl Quantizer {
             separations: separations.list.len(),
             separations_held: held.list.len(),
             separations_violated,
+            free_curve_ends: self.curve_ends.iter().filter(|end| end.free_at(s)).count(),
         })
     }
 
@@ -1445,6 +1398,7 @@ impl Fit {
 }
 
 /// The outcome of one [`Quantizer::round_and_polish`].
+#[derive(Default)]
 struct Rounded {
     x: Vec<f64>,
     values: Vec<Option<i64>>,
@@ -1464,16 +1418,15 @@ struct Rounded {
     separations: usize,
     separations_held: usize,
     separations_violated: usize,
+    /// Ends of feature curves left off the grid points at its grid size.
+    free_curve_ends: usize,
 }
 
-/// How a pass of [`Quantizer::round_and_polish`] rounds: holding the
-/// separations it leaves violated as rows ([`HeldApart`]), and taking each
-/// batch from every component's forms alike (else from all forms by
-/// distance to their integers).
+/// How a pass of [`Quantizer::round_and_polish`] rounds: with `hold`,
+/// holding the separations it leaves violated as rows ([`HeldApart`]).
 #[derive(Clone, Copy, Default)]
 struct Pass {
     hold: bool,
-    per_component: bool,
 }
 
 /// What quantization at one grid size keeps to beyond the forms.
@@ -1564,6 +1517,18 @@ impl RoundedSystem {
             }));
         }
         Ok(x[..q.n_unknowns].to_vec())
+    }
+}
+
+/// Keeps the better of `best` and `candidate` (rounded at grid length
+/// `s`) by (collapsed faces, wound vertices, fit distortion). Flipped or
+/// collapsed faces leave holes in the quad mesh; a cell the map winds
+/// around is closed with quads (an extra singular vertex): fewer of the
+/// first, then of the second, count first.
+fn keep_better(best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64) {
+    let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
+    if best.as_ref().is_none_or(|(b, _)| key(&candidate) < key(b)) {
+        *best = Some((candidate, s));
     }
 }
 
