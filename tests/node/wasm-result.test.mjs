@@ -106,3 +106,17 @@ test('quads of a low-poly mesh are traced on a map solved again on its refinemen
   assert.deepEqual([...again], ['quantization', 'quad extraction'], 'another count re-runs only quantization and extraction');
   assert.equal(r2.solved_faces, r.solved_faces);
 });
+
+test('quads of a game asset of 56 parts: every part rounded on its own, the quad mesh closed', () => {
+  const session = open(sharedMesh('xatlas-gazebo'));
+  session.solve(new Uint32Array(), undefined, false, () => {});
+  const r = session.quads(3000, () => {});
+  assert.equal(r.defects, 0);
+  assert.equal(r.quantization.flipped, 0);
+  assert.equal(r.quantization.wound_vertices, 0);
+  assert.equal(r.quantization.conflicts, 0);
+  assert.equal(r.report.euler_characteristic, 111, 'the input has 56 parts: V - E + F = 111');
+  assert.ok(Math.abs(r.report.quads - 3000) < 900, `${r.report.quads} quads for 3000`);
+  const singular = r.report.singular_vertices.filter((v) => !v.boundary);
+  assert.ok(singular.every((v) => v.valence >= 2 && v.valence !== 4), 'singular vertices have valence 4 - k, k != 0');
+});
