@@ -37,6 +37,7 @@ pub(super) struct CurveEnd {
 
 impl CurveEnd {
     /// Whether the end is left free at grid size `s`.
+    #[inline]
     pub(super) fn free_at(&self, s: f64) -> bool {
         self.length < super::CURVE_END_CELLS * s
     }
@@ -54,6 +55,7 @@ pub(super) struct Form {
 }
 
 impl Form {
+    #[inline]
     pub(super) fn value(&self, x: &[f64]) -> f64 {
         self.row.iter().map(|&(i, c)| c as f64 * x[i]).sum()
     }
