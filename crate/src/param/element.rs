@@ -80,6 +80,7 @@ pub(super) fn angle_sums(faces: &[[u32; 3]], n_vertices: usize, uv_of: impl Fn(u
 
 /// A face of a linear system on shared unknowns: its corners' wedges and
 /// unknowns, its hat gradients and its area.
+#[derive(Clone, Copy)]
 pub(super) struct Element {
     /// Wedges of the three corners.
     pub(super) w: [usize; 3],

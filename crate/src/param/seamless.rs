@@ -350,7 +350,7 @@ pub fn seamless_map(
     let mut realized = Vec::new();
     if best_flips > 0 && options.untangle.max_outer > 0 && sys.projector.is_some() {
         let untangled;
-        (untangle_iterations, untangled) = untangle_folds(&mut sys, &mut weights, placement, &best_uv, &mut cone_angle, options)?;
+        (untangle_iterations, untangled) = untangle_folds(&mut sys, &mut weights, mesh.face_components(), placement, &best_uv, &mut cone_angle, options)?;
         if let Some(u) = untangled {
             realized = u.realized;
             best_flips = 0;
@@ -502,13 +502,17 @@ fn repair_folds(
 }
 
 /// Untangles the folded map `start` (sec. [`super::untangle`]), preconditioned
-/// by the unweighted KKT (`weights` reset to 1, one factorization). Returns
+/// by the unweighted KKT (`weights` reset to 1, one factorization), on the
+/// components of the mesh (`face_part`: per face) that hold an inverted
+/// triangle: no constraint couples two components, so the others keep
+/// their map, and each iteration costs their energy only. Returns
 /// the iterations, and the map when it satisfies the constraints with every
 /// triangle positive, with the cones it realizes otherwise than placed
 /// (`cone_angle` updated to match).
 fn untangle_folds(
     sys: &mut System,
     weights: &mut [f64],
+    face_part: &[u32],
     placement: &ConePlacement,
     start: &[[f64; 2]],
     cone_angle: &mut [f64],
@@ -518,7 +522,12 @@ fn untangle_folds(
     sys.refactor(weights)?;
     let precondition = |q: &mut [f64]| sys.precondition(q);
     let mut x = sys.unknowns_of(start);
-    let stats = untangle(&sys.elements, &precondition, &mut x, &options.untangle);
+    let mut tangled = vec![false; face_part.iter().map(|&c| c as usize + 1).max().unwrap_or(0)];
+    for (el, &c) in sys.elements.iter().zip(face_part) {
+        tangled[c as usize] |= !(signed_uv_area(el.unknowns_uv(&x)) > 0.0);
+    }
+    let active: Vec<Element> = sys.elements.iter().zip(face_part).filter(|(_, &c)| tangled[c as usize]).map(|(el, _)| *el).collect();
+    let stats = untangle(&active, &precondition, &mut x, &options.untangle);
     if let Some(projector) = &sys.projector {
         projector.project(&mut x, CONSTRAINT_TOLERANCE, 3);
     }
