@@ -639,12 +639,9 @@ impl Quantizer {
             stiff_weight: 1.0,
             ..Rounded::default()
         };
-        let (mut s_joined, mut largest, mut rounded_forms) = (s, 0.0, 0);
-        for part in &self.parts {
-            let q = &part.quantizer;
-            let mut part_progress = |done: usize, _: usize| progress(rounded_forms + done, self.forms.len());
-            let (r, s_part) = q.round(s, retry, options, &mut part_progress)?;
-            rounded_forms += q.forms.len();
+        let (mut s_joined, mut largest) = (s, 0.0);
+        for (part, rounded) in self.parts.iter().zip(self.round_each_part(s, retry, options, progress)) {
+            let (q, (r, s_part)) = (&part.quantizer, rounded?);
             for (&u, &v) in part.unknown.iter().zip(&r.x) {
                 joined.x[u] = v;
             }
@@ -670,6 +667,56 @@ impl Quantizer {
         // Untangled: some part's flips were all removed and no part has any left.
         joined.untangled &= joined.collapsed == 0;
         Ok((joined, s_joined))
+    }
+
+    /// [`Self::round`] of every part, in part order. Natively the parts are
+    /// shared with a helper thread (largest first, each to the thread with
+    /// fewer faces so far; the helper's parts report no progress): they
+    /// share nothing, so the outcome is the same as on one thread.
+    fn round_each_part(
+        &self,
+        s: f64,
+        retry: bool,
+        options: &QuantizeOptions,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Vec<Result<(Rounded, f64), QuantizeError>> {
+        let mut on_helper = vec![false; self.parts.len()];
+        if cfg!(not(target_arch = "wasm32")) {
+            let mut order: Vec<usize> = (0..self.parts.len()).collect();
+            order.sort_by_key(|&i| std::cmp::Reverse(self.parts[i].quantizer.elements.len()));
+            let (mut here, mut there) = (0, 0);
+            for i in order {
+                let faces = self.parts[i].quantizer.elements.len();
+                if there < here {
+                    (on_helper[i], there) = (true, there + faces);
+                } else {
+                    here += faces;
+                }
+            }
+        }
+        let total: usize = self.parts.iter().zip(&on_helper).filter(|(_, &h)| !h).map(|(p, _)| p.quantizer.forms.len()).sum();
+        let round_some = |helper: bool, progress: &mut dyn FnMut(usize, usize)| {
+            let mut rounded_forms = 0;
+            let mut out = Vec::new();
+            for (i, part) in self.parts.iter().enumerate().filter(|&(i, _)| on_helper[i] == helper) {
+                let q = &part.quantizer;
+                out.push((i, q.round(s, retry, options, &mut |done, _| progress(rounded_forms + done, total))));
+                rounded_forms += q.forms.len();
+            }
+            out
+        };
+        let (mut mine, theirs) = if on_helper.contains(&true) {
+            std::thread::scope(|scope| {
+                let helper = scope.spawn(|| round_some(true, &mut |_, _| {}));
+                let mine = round_some(false, progress);
+                (mine, helper.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+            })
+        } else {
+            (round_some(false, progress), Vec::new())
+        };
+        mine.extend(theirs);
+        mine.sort_by_key(|(i, _)| *i);
+        mine.into_iter().map(|(_, r)| r).collect()
     }
 
     /// How good the rounded map `x` (grid length `s`) is: (collapsed faces,
