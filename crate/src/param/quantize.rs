@@ -55,7 +55,8 @@
 //!
 //! A mesh of several parts (components) is quantized one part at a time
 //! ([`parts`]): they share no unknown, so each rounds as it would alone,
-//! with its own passes, and a pass costs only the part it re-runs.
+//! with its own passes, and a pass costs only the part it re-runs; natively
+//! the parts are shared between two threads.
 //!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
 //! batch (the rows change; about ten batches), and up to seven passes where
