@@ -79,9 +79,6 @@ use super::seamless::{
 use super::separation::{HeldApart, Separation, Separations};
 use super::untangle::{untangle, UntangleOptions};
 use super::{ParamError, Parametrization};
-
-mod forms;
-mod parts;
 use crate::clock::Stopwatch;
 use crate::cones::ConePlacement;
 use crate::linalg::{
@@ -96,6 +93,9 @@ use parts::Part;
 use serde::Serialize;
 use std::f64::consts::PI;
 use std::fmt;
+
+mod forms;
+mod parts;
 
 /// Share of the remaining forms of a class rounded per batch.
 const BATCH_FRACTION: f64 = 0.5;
@@ -630,7 +630,9 @@ impl Quantizer {
     }
 
     /// [`Self::round`] of every part on its own, joined: the unknowns and
-    /// forms of each part from its rounding, the counts summed. A part may
+    /// forms of each part from its rounding, the counts summed (the joined
+    /// map's wound vertices and distortion are not: `quantize_with` measures
+    /// the whole map). A part may
     /// keep a retried grid length of its own; the length returned is that
     /// of the part with the largest map area.
     fn round_parts(&self, s: f64, retry: bool, options: &QuantizeOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<(Rounded, f64), QuantizeError> {
@@ -658,8 +660,6 @@ impl Quantizer {
             joined.arap_iterations = joined.arap_iterations.max(r.arap_iterations);
             joined.untangled |= r.untangled;
             joined.collapsed += r.collapsed;
-            joined.wound += r.wound;
-            joined.distortion += r.distortion * q.map_area / self.map_area;
             joined.separations += r.separations;
             joined.separations_held += r.separations_held;
             joined.separations_violated += r.separations_violated;
