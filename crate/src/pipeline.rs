@@ -15,8 +15,10 @@ use std::borrow::Cow;
 use std::fmt;
 
 mod location;
+mod parts;
 pub use location::{enclosing_features, ErrorLocation, MAX_LOCATION_EDGES};
 use location::Lift;
+use parts::Parts;
 
 /// Settings of both stages.
 #[derive(Clone, Copy, Debug, Default)]
@@ -383,8 +385,26 @@ impl Solution<'_> {
     }
 }
 
-/// Solves on `mesh` with `features` (see the module doc).
+/// Solves on `mesh` with `features` (see the module doc); a mesh of
+/// several components one component at a time ([`Parts`]).
 pub fn solve<'a>(
+    mesh: &'a TriMesh,
+    features: &'a FeatureSet,
+    options: &SolveOptions,
+    progress: &mut dyn FnMut(SolveProgress),
+) -> Result<Solution<'a>, SolveError> {
+    match Parts::split(mesh, features) {
+        Some(parts) => {
+            let solutions = parts.solve_each(options, progress)?;
+            Ok(parts.join(mesh, features, &solutions, options))
+        }
+        None => solve_one(mesh, features, options, progress),
+    }
+}
+
+/// [`solve`] on `mesh` as one: cones on all its components, then one
+/// parametrization with its refinements and fallbacks.
+fn solve_one<'a>(
     mesh: &'a TriMesh,
     features: &'a FeatureSet,
     options: &SolveOptions,
@@ -447,6 +467,123 @@ enum ConeStep {
     /// Cones of angle 0 appeared: the mesh was refined around them; place
     /// the new stage's components again.
     Again(ConeStage),
+}
+
+/// [`solve`] in steps, so that components can be placed anywhere (other
+/// wasm instances that built the same stage): [`SolveStage::new`], place
+/// every component of [`SolveStage::schedule`], then
+/// [`SolveStage::finish`]. A mesh of several components is staged part by
+/// part ([`Parts`]); its components are numbered across the parts. Every
+/// method takes the same `mesh` and `features`.
+pub enum SolveStage {
+    One(ConeStage),
+    /// Each part's stage, and the number of components before it.
+    Parts { parts: Parts, stages: Vec<ConeStage>, first: Vec<usize> },
+}
+
+impl SolveStage {
+    pub fn new(mesh: &TriMesh, features: &FeatureSet, options: &SolveOptions) -> SolveStage {
+        let Some(parts) = Parts::split(mesh, features) else {
+            return SolveStage::One(ConeStage::new(mesh, features, options));
+        };
+        let stages: Vec<ConeStage> = (0..parts.len()).map(|p| ConeStage::new(&parts.part(p).mesh, &parts.part(p).features, options)).collect();
+        let first = stages
+            .iter()
+            .scan(0, |n, s| {
+                let before = *n;
+                *n += s.problem().n_components();
+                Some(before)
+            })
+            .collect();
+        SolveStage::Parts { parts, stages, first }
+    }
+
+    /// Number of components to place.
+    pub fn n_components(&self) -> usize {
+        match self {
+            SolveStage::One(stage) => stage.problem().n_components(),
+            SolveStage::Parts { stages, .. } => stages.iter().map(|s| s.problem().n_components()).sum(),
+        }
+    }
+
+    /// The components in the order to place them (most faces first).
+    pub fn schedule(&self) -> Vec<usize> {
+        match self {
+            SolveStage::One(stage) => stage.problem().schedule(),
+            SolveStage::Parts { stages, first, .. } => {
+                let mut all: Vec<(usize, usize)> = stages
+                    .iter()
+                    .zip(first)
+                    .flat_map(|(s, &first)| s.problem().component_faces().into_iter().enumerate().map(move |(c, n)| (first + c, n)))
+                    .collect();
+                all.sort_by_key(|&(c, n)| (std::cmp::Reverse(n), c));
+                all.into_iter().map(|(c, _)| c).collect()
+            }
+        }
+    }
+
+    /// Places component `c` (< [`Self::n_components`]); an error is located on the input.
+    pub fn place_component(
+        &self,
+        mesh: &TriMesh,
+        features: &FeatureSet,
+        c: usize,
+        progress: &mut dyn FnMut(cones::ConeProgress),
+    ) -> Result<ComponentPlacement, SolveError> {
+        match self {
+            SolveStage::One(stage) => stage.problem().place_component(c, progress).map_err(|e| stage.cone_error(mesh, features, e)),
+            SolveStage::Parts { parts, stages, first } => {
+                let p = first.partition_point(|&f| f <= c) - 1;
+                let part = parts.part(p);
+                let mut placed = stages[p]
+                    .problem()
+                    .place_component(c - first[p], progress)
+                    .map_err(|e| parts.lift_error(p, stages[p].cone_error(&part.mesh, &part.features, e)))?;
+                placed.component = c;
+                Ok(placed)
+            }
+        }
+    }
+
+    /// Joins the placed components (each from [`Self::place_component`],
+    /// here or in another instance) and parametrizes ([`Placed::parametrize`];
+    /// part by part, then [`Parts::join`]).
+    pub fn finish<'a>(
+        self,
+        mesh: &'a TriMesh,
+        features: &'a FeatureSet,
+        placed: Vec<ComponentPlacement>,
+        progress: &mut dyn FnMut(SolveProgress),
+    ) -> Result<Solution<'a>, SolveError> {
+        let total = self.n_components();
+        match self {
+            SolveStage::One(stage) => stage
+                .complete(mesh, features, placed, &mut |p| progress(SolveProgress::Cones(p)))?
+                .parametrize(mesh, features, progress),
+            SolveStage::Parts { parts, stages, first } => {
+                let options = stages.first().map(|s| s.options).unwrap_or_default();
+                let mut of_part: Vec<Vec<ComponentPlacement>> = vec![Vec::new(); parts.len()];
+                for mut r in placed {
+                    if r.component >= total {
+                        return Err(SolveError::unlocated(SolveCause::Components(MismatchError(format!("component {} is out of range", r.component)))));
+                    }
+                    let p = first.partition_point(|&f| f <= r.component) - 1;
+                    r.component -= first[p];
+                    of_part[p].push(r);
+                }
+                let mut solutions = Vec::with_capacity(parts.len());
+                for (p, (stage, placed)) in stages.into_iter().zip(of_part).enumerate() {
+                    let part = parts.part(p);
+                    let solution = stage
+                        .complete(&part.mesh, &part.features, placed, &mut |c| progress(SolveProgress::Cones(c)))
+                        .and_then(|placed| placed.parametrize(&part.mesh, &part.features, progress))
+                        .map_err(|e| parts.lift_error(p, e))?;
+                    solutions.push(solution);
+                }
+                Ok(parts.join(mesh, features, &solutions, &options))
+            }
+        }
+    }
 }
 
 /// A finished cone stage, ready for [`Placed::parametrize`].

@@ -8,7 +8,7 @@ use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::quantize::{GridSize, QuantizeReport, Quantizer};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
 use crate::quads::{self, check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
-use crate::pipeline::{self, ConeStage, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress};
+use crate::pipeline::{self, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
 use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -93,7 +93,7 @@ struct GridStage {
 struct Job {
     features: FeatureSet,
     options: SolveOptions,
-    stage: ConeStage,
+    stage: SolveStage,
     placed: Vec<ComponentPlacement>,
 }
 
@@ -261,8 +261,8 @@ impl MeshSession {
         self.grid = None;
         let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
         let options = SolveOptions { cones, param: ParamOptions::default(), refine: self.refine };
-        let stage = ConeStage::new(mesh, &features, &options);
-        let schedule = stage.problem().schedule().iter().map(|&c| c as u32).collect();
+        let stage = SolveStage::new(mesh, &features, &options);
+        let schedule = stage.schedule().iter().map(|&c| c as u32).collect();
         self.job = Some(Job { features, options, stage, placed: Vec::new() });
         Ok(schedule)
     }
@@ -272,14 +272,15 @@ impl MeshSession {
     /// A placement error throws with a `location` where it names mesh elements.
     pub fn solve_place(&mut self, component: u32, share: bool, progress: &Function) -> Result<Option<Uint8Array>, JsValue> {
         let job = self.job.as_mut().ok_or_else(|| JsError::new("no solve was started"))?;
-        let problem = job.stage.problem();
-        if component as usize >= problem.n_components() {
-            return Err(JsError::new(&format!("component {component} is out of range ({} components)", problem.n_components())).into());
+        let n = job.stage.n_components();
+        if component as usize >= n {
+            return Err(JsError::new(&format!("component {component} is out of range ({n} components)")).into());
         }
         let mesh = self.mesh.as_ref().ok_or_else(|| JsError::new("no valid mesh is open"))?;
-        let placed = problem
-            .place_component(component as usize, &mut cone_progress(progress))
-            .map_err(|e| solve_error(&job.stage.cone_error(mesh, &job.features, e)))?;
+        let placed = job
+            .stage
+            .place_component(mesh, &job.features, component as usize, &mut cone_progress(progress))
+            .map_err(|e| solve_error(&e))?;
         let bytes = share.then(|| Uint8Array::from(&placed.to_json()[..]));
         job.placed.push(placed);
         Ok(bytes)
@@ -301,8 +302,7 @@ impl MeshSession {
         let Job { features, options, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
         let mesh = self.valid_mesh()?;
         let fail = |e: SolveError| solve_error(&e);
-        let placed = stage.complete(mesh, &features, placed, &mut cone_progress(progress)).map_err(fail)?;
-        let sol = placed.parametrize(mesh, &features, &mut solve_progress(progress)).map_err(fail)?;
+        let sol = stage.finish(mesh, &features, placed, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
         // As solved: a low-poly fallback's edge length is not asked again.
         let options = SolveOptions { refine: sol.refine_options, ..options };

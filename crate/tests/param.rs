@@ -6,12 +6,12 @@
 use conemap::cones::ConeOptions;
 use conemap::features::FeatureSet;
 use conemap::pipeline::{solve, SolveOptions};
-use conemap::mesh::TriMesh;
+use conemap::mesh::{RawMesh, TriMesh};
 use conemap::param::{metrics::uv_angle_sums, ParamOptions};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 mod common;
-use common::shared_mesh as load;
+use common::{shared_mesh as load, shared_raw};
 
 /// Solves `name` and checks the map; `max_flip_fraction` is the share of
 /// flipped triangles tolerated (0 except where a known shortfall is stated).
@@ -19,7 +19,14 @@ use common::shared_mesh as load;
 /// the comments, also in docs/STATUS.md): a regression of the placement or
 /// the map fails them.
 fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f64) {
-    let input = load(name);
+    run_on(name, &load(name), sharp, max_distortion, max_flip_fraction);
+}
+
+/// [`run`] on `input`; also: the UVs agree on both sides of every interior
+/// edge that is not a seam, and every feature edge asked for is aligned
+/// (on the input, through the refinement's maps).
+fn run_on(name: &str, input: &TriMesh, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f64) {
+    let input = input.clone();
     let features = match sharp {
         Some(deg) => FeatureSet::sharp_edges(&input, deg),
         None => FeatureSet::none(&input),
@@ -60,6 +67,15 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
     assert!(m.flipped <= allowed, "{name}: {} flipped triangles (allowed {allowed})", m.flipped);
     assert_eq!(m.wound_vertices, 0, "{name}: the map winds more than once around a vertex");
     assert!(m.distortion < max_distortion, "{name}: distortion {}", m.distortion);
+    let mut seam = vec![false; mesh.n_edges()];
+    p.seam_edges.iter().for_each(|&e| seam[e as usize] = true);
+    for e in (0..mesh.n_edges() as u32).filter(|&e| !seam[e as usize] && !mesh.is_boundary_edge(e)) {
+        let [h, t] = mesh.edge_halfedges(e);
+        let same = |a: u32, b: u32| p.uv[a as usize] == p.uv[b as usize];
+        assert!(same(h, mesh.next(t)) && same(mesh.next(h), t), "{name}: the map is cut along edge {e}, not a seam");
+    }
+    let alignment = solution.feature_alignment(&input, &features);
+    assert_eq!(alignment.aligned, alignment.requested, "{name}: {:?}", alignment.unaligned.first());
 
     // UV angle sums at interior vertices: 2 pi - k pi/2.
     let mut k = vec![0i32; mesh.n_vertices()];
@@ -89,6 +105,42 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
             sums[v as usize]
         );
     }
+}
+
+/// The shared meshes `names` side by side as one mesh (each moved clear of the ones before).
+fn side_by_side(names: &[&str]) -> TriMesh {
+    let mut raw = RawMesh { positions: Vec::new(), triangles: Vec::new() };
+    let mut x = 0.0;
+    for name in names {
+        let r = shared_raw(name);
+        let (lo, hi) = r.positions.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
+        let base = raw.positions.len() as u32;
+        raw.positions.extend(r.positions.iter().map(|p| [p[0] - lo + x, p[1], p[2]]));
+        raw.triangles.extend(r.triangles.iter().map(|t| t.map(|v| v + base)));
+        x += 1.1 * (hi - lo);
+    }
+    TriMesh::from_raw(&raw).unwrap()
+}
+
+/// A mesh of several components is solved one component at a time and the
+/// solutions joined: the joined map passes every check of [`run_on`] (cone
+/// angle sums, seams, continuity, alignment), with fandisk refined for its
+/// features and the hemisphere not.
+#[test]
+fn components_are_solved_apart_and_joined() {
+    let input = side_by_side(&["fandisk.obj", "bff-hemisphere.obj", "fandisk.obj"]);
+    assert_eq!(input.n_components(), 3);
+    run_on("fandisk, hemisphere and fandisk", &input, Some(60.0), 0.185, 0.0);
+    let features = FeatureSet::none(&input);
+    let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    assert!(solution.original_face.is_none(), "without features nothing is refined: the mesh solved is the input");
+    // Gauss-Bonnet on each component: its cones and corners add up to 4 chi.
+    let mut k_sum = vec![0i64; input.n_components()];
+    for c in solution.placement.cones.iter().chain(&solution.placement.boundary_corners) {
+        k_sum[input.vertex_component(c.vertex)] += c.k as i64;
+    }
+    let expected: Vec<i64> = (0..input.n_components()).map(|c| 4 * input.component_euler_characteristic(c)).collect();
+    assert_eq!(k_sum, expected);
 }
 
 #[test]

@@ -307,7 +307,7 @@ pub fn place_all(problem: &ConeProblem, progress: &mut dyn FnMut(ConeProgress)) 
 /// Cone indices on the input mesh from the cut-vertex integers: a vertex cut
 /// into `n` boundary sectors has cone angle `sum (pi - k_s pi/2)`, so
 /// `k = sum k_s + 2 (2 - n)` inside and `sum k_s + 2 (1 - n)` on the boundary.
-fn original_cones(mesh: &TriMesh, cut: &CutMesh, k: &[i32]) -> (Vec<Cone>, Vec<Cone>) {
+pub(crate) fn original_cones(mesh: &TriMesh, cut: &CutMesh, k: &[i32]) -> (Vec<Cone>, Vec<Cone>) {
     let n = mesh.n_vertices();
     let mut sum = vec![0i32; n];
     let mut sectors = vec![0i32; n];

@@ -55,7 +55,7 @@ pub struct RefineCounts {
 }
 
 impl RefineCounts {
-    fn add(&mut self, o: &RefineCounts) {
+    pub(crate) fn add(&mut self, o: &RefineCounts) {
         self.lone_edges += o.lone_edges;
         self.triply_constrained += o.triply_constrained;
         self.doubly_constrained += o.doubly_constrained;
