@@ -75,25 +75,37 @@ test('bad requests give readable errors, not crashes', () => {
   assert.equal(sumK(session.place_cones(session.sharp_edges(60), 0.01, false, () => {})), 8);
 });
 
-test('a solve in steps across two sessions equals the one-call solve', () => {
-  const a = open(committedFandisk);
-  const b = open(committedFandisk);
+/** Solves `bytes` in steps across two sessions (every other component placed
+ * in the second and handed over as bytes); checks it equals the one-call
+ * solve; returns the first session (its solve finished) and the features. */
+function solveAcrossSessions(bytes, minComponents) {
+  const a = open(bytes);
+  const b = open(bytes);
   const sharp = a.sharp_edges(60);
   const schedule = a.solve_begin(sharp, 0.01, false);
   assert.deepEqual([...b.solve_begin(sharp, 0.01, false)], [...schedule]);
-  assert.ok(schedule.length > 2, `${schedule.length} components`);
+  assert.ok(schedule.length >= minComponents, `${schedule.length} components`);
   assert.deepEqual([...schedule].sort((x, y) => x - y), [...schedule.keys()], 'every component once');
-  // b places every other component and hands it to a as bytes.
   schedule.forEach((c, i) => {
     if (i % 2) a.solve_add(b.solve_place(c, true, () => {}));
     else assert.equal(a.solve_place(c, false, () => {}), undefined);
   });
   const split = a.solve_finish(() => {});
-  const whole = open(committedFandisk).solve(sharp, 0.01, false, () => {});
+  const whole = open(bytes).solve(sharp, 0.01, false, () => {});
   assert.equal(split.energy, whole.energy);
   assert.deepEqual(split.cones, whole.cones);
   assert.ok(split.uv.length === whole.uv.length && split.uv.every((v, i) => v === whole.uv[i]), 'same UVs to the bit');
   assert.equal(split.metrics.flipped, 0);
+  return { a, sharp, schedule, whole };
+}
+
+test('a mesh of 56 parts solved in steps across two sessions equals the one-call solve', () => {
+  // Components are numbered across the parts, each solved on its own.
+  solveAcrossSessions(sharedMesh('xatlas-gazebo'), 56);
+});
+
+test('a solve in steps across two sessions equals the one-call solve', () => {
+  const { a, sharp, schedule, whole } = solveAcrossSessions(committedFandisk, 3);
   // Misuse gets clear errors and leaves the session usable.
   assert.throws(() => a.solve_finish(() => {}), /no solve was started/);
   a.solve_begin(sharp, 0.01, false);
