@@ -395,8 +395,8 @@ pub fn solve<'a>(
 ) -> Result<Solution<'a>, SolveError> {
     match Parts::split(mesh, features) {
         Some(parts) => {
-            let solutions = parts.solve_each(options, progress)?;
-            Ok(parts.join(mesh, features, &solutions, options))
+            let (solutions, wall_share) = parts.solve_each(options, progress)?;
+            Ok(parts.join(mesh, features, &solutions, options, wall_share))
         }
         None => solve_one(mesh, features, options, progress),
     }
@@ -580,7 +580,7 @@ impl SolveStage {
                         .map_err(|e| parts.lift_error(p, e))?;
                     solutions.push(solution);
                 }
-                Ok(parts.join(mesh, features, &solutions, &options))
+                Ok(parts.join(mesh, features, &solutions, &options, 1.0))
             }
         }
     }

@@ -9,6 +9,7 @@
 
 use super::location::ErrorLocation;
 use super::{Solution, SolveError, SolveOptions, SolveProgress};
+use crate::clock::now_seconds;
 use crate::cones::{original_cones, BoundaryMode, ConePlacement, ConeTimings};
 use crate::features::{cut_open, FeatureSet, RefineCounts};
 use crate::mesh::{TriMesh, NONE};
@@ -119,11 +120,17 @@ impl Parts {
     /// helper (largest parts first; the helper reports no progress), in
     /// wasm one after another. A part's error is returned located on the
     /// input ([`Self::lift_error`]).
-    pub fn solve_each(&self, options: &SolveOptions, progress: &mut dyn FnMut(SolveProgress)) -> Result<Vec<Solution<'_>>, SolveError> {
+    ///
+    /// Also returns the wall-clock time over the parts' own times summed,
+    /// for [`Self::join`] (below 1 where two parts ran at once).
+    pub fn solve_each(&self, options: &SolveOptions, progress: &mut dyn FnMut(SolveProgress)) -> Result<(Vec<Solution<'_>>, f64), SolveError> {
+        let started = now_seconds();
         let order = self.largest_first();
         let solve = |p: usize, progress: &mut dyn FnMut(SolveProgress)| {
             let part = &self.parts[p];
-            (p, super::solve_one(&part.mesh, &part.features, options, progress))
+            let started = now_seconds();
+            let solution = super::solve_one(&part.mesh, &part.features, options, progress);
+            (p, solution, now_seconds() - started)
         };
         #[cfg(not(target_arch = "wasm32"))]
         let mut results = {
@@ -140,7 +147,10 @@ impl Parts {
         #[cfg(target_arch = "wasm32")]
         let mut results: Vec<_> = order.iter().map(|&p| solve(p, progress)).collect();
         results.sort_by_key(|r| r.0);
-        results.into_iter().map(|(p, r)| r.map_err(|e| self.lift_error(p, e))).collect()
+        let summed: f64 = results.iter().map(|r| r.2).sum();
+        let wall_share = ((now_seconds() - started) / summed.max(f64::MIN_POSITIVE)).min(1.0);
+        let solutions = results.into_iter().map(|(p, r, _)| r.map_err(|e| self.lift_error(p, e))).collect::<Result<_, _>>()?;
+        Ok((solutions, wall_share))
     }
 
     /// `e`, from solving part `p`, located on the input: its location's
@@ -163,7 +173,18 @@ impl Parts {
     /// solved mesh is `mesh` itself; else the parts' solved meshes side by
     /// side, with maps to the input composed through the parts'.
     /// `options`: those the parts were solved with (the cut's boundary mode).
-    pub fn join<'a>(&self, mesh: &'a TriMesh, features: &'a FeatureSet, solutions: &[Solution<'_>], options: &SolveOptions) -> Solution<'a> {
+    /// The refinement and cone-stage seconds are the parts' summed, times
+    /// `wall_share` (wall-clock over summed time, from [`Self::solve_each`];
+    /// 1 where the parts ran one after another), so that with the
+    /// parametrization's they add up to the wall-clock time.
+    pub fn join<'a>(
+        &self,
+        mesh: &'a TriMesh,
+        features: &'a FeatureSet,
+        solutions: &[Solution<'_>],
+        options: &SolveOptions,
+        wall_share: f64,
+    ) -> Solution<'a> {
         assert_eq!(solutions.len(), self.parts.len(), "one solution per part");
         let refined = solutions.iter().any(|s| s.original_face.is_some());
         // Joined face -> (part, face of the part's solved mesh).
@@ -195,7 +216,8 @@ impl Parts {
             let (p, r) = at[(h / 3) as usize];
             (p, solutions[p].mesh.edge(3 * r + h % 3))
         };
-        let placement = join_placements(m, &solved_features, solutions, &at, options);
+        let mut placement = join_placements(m, &solved_features, solutions, &at, options);
+        placement.timings.total *= wall_share;
         let cut = &placement.cut.mesh;
         // Part cut vertex -> joined cut vertex, and the per-corner values.
         let mut cut_vertex: Vec<Vec<u32>> = solutions.iter().map(|s| vec![NONE; s.placement.cut.mesh.n_vertices()]).collect();
@@ -252,7 +274,7 @@ impl Parts {
             flip_refinements: solutions.iter().map(|s| s.flip_refinements).max().unwrap_or(0),
             placement,
             param,
-            refine_seconds: solutions.iter().map(|s| s.refine_seconds).sum(),
+            refine_seconds: wall_share * solutions.iter().map(|s| s.refine_seconds).sum::<f64>(),
             // A part's low-poly fallback shows here (as solved, for the next solve).
             refine_options: solutions.iter().map(|s| s.refine_options).find(|r| *r != options.refine).unwrap_or(options.refine),
         }
