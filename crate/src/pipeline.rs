@@ -1,8 +1,10 @@
 //! The whole method in one call: refine doubly constrained triangles, place
 //! cones (sections 4-5) — refining around any vertex that would need a cone
 //! of angle 0 and placing them again —, then compute the seamless aligned
-//! parametrization (Appendix B). The CLI calls [`solve`]; the wasm API runs
-//! the same steps ([`ConeStage`]) so that a helper worker can place components.
+//! parametrization (Appendix B). A mesh of several components is solved one
+//! component at a time and the solutions joined (module `parts`). The CLI
+//! calls [`solve`]; the wasm API runs the same steps ([`SolveStage`]) so
+//! that a helper worker can place components.
 //! Errors that name mesh elements carry them in input-mesh indices
 //! ([`SolveError::location`], module `location`).
 

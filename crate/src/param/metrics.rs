@@ -168,32 +168,43 @@ pub fn distortion(mesh: &TriMesh, uv: &[[f64; 2]]) -> f64 {
     best_scale_mean(&face_parts(mesh, uv)).0
 }
 
-/// The distortion figures of [`Metrics`] (distortion, scale, fractions
-/// below 0.2 and 0.3, largest) for per-corner `uv`, at one global scale.
-fn distortion_figures(mesh: &TriMesh, uv: &[[f64; 2]]) -> (f64, f64, f64, f64, f64) {
-    let parts = face_parts(mesh, uv);
-    let (distortion, scale) = best_scale_mean(&parts);
-    let per_tri: Vec<f64> = parts.iter().map(|&(c, a, _)| tri_distortion(c, a, scale)).collect();
-    let n = per_tri.len().max(1) as f64;
-    let below = |t: f64| per_tri.iter().filter(|&&d| d < t).count() as f64 / n;
-    (distortion, scale, below(0.2), below(0.3), per_tri.iter().cloned().fold(0.0, f64::max))
-}
-
 impl Metrics {
+    /// The distortion figures (distortion, scale, fractions below 0.2 and
+    /// 0.3, largest) of per-corner `uv` at one global scale, and `faces`;
+    /// every count and residual 0.
+    fn of_distortion(mesh: &TriMesh, uv: &[[f64; 2]]) -> Metrics {
+        let parts = face_parts(mesh, uv);
+        let (distortion, scale) = best_scale_mean(&parts);
+        let per_tri: Vec<f64> = parts.iter().map(|&(c, a, _)| tri_distortion(c, a, scale)).collect();
+        let n = per_tri.len().max(1) as f64;
+        let below = |t: f64| per_tri.iter().filter(|&&d| d < t).count() as f64 / n;
+        Metrics {
+            distortion,
+            scale,
+            fraction_below_0_2: below(0.2),
+            fraction_below_0_3: below(0.3),
+            max_distortion: per_tri.iter().cloned().fold(0.0, f64::max),
+            flipped: 0,
+            wound_vertices: 0,
+            seam_angle_residual: 0.0,
+            seam_length_residual: 0.0,
+            alignment_residual: 0.0,
+            cones: 0,
+            boundary_corners: 0,
+            seam_edges: 0,
+            seam_length: 0.0,
+            faces: mesh.n_faces(),
+        }
+    }
+
     /// The figures of a map joined from maps of separate components, each
     /// measured on its own (`parts`): the distortion figures measured again
     /// on the joined `mesh` and per-corner `uv` (one global scale), counts
     /// and lengths summed, residuals the largest.
     pub fn join(parts: &[Metrics], mesh: &TriMesh, uv: &[[f64; 2]]) -> Metrics {
-        let (distortion, scale, fraction_below_0_2, fraction_below_0_3, max_distortion) = distortion_figures(mesh, uv);
         let sum = |f: fn(&Metrics) -> usize| parts.iter().map(f).sum::<usize>();
         let max = |f: fn(&Metrics) -> f64| parts.iter().map(f).fold(0.0, f64::max);
         Metrics {
-            distortion,
-            scale,
-            fraction_below_0_2,
-            fraction_below_0_3,
-            max_distortion,
             flipped: sum(|m| m.flipped),
             wound_vertices: sum(|m| m.wound_vertices),
             seam_angle_residual: max(|m| m.seam_angle_residual),
@@ -203,7 +214,7 @@ impl Metrics {
             boundary_corners: sum(|m| m.boundary_corners),
             seam_edges: sum(|m| m.seam_edges),
             seam_length: parts.iter().map(|m| m.seam_length).sum(),
-            faces: mesh.n_faces(),
+            ..Metrics::of_distortion(mesh, uv)
         }
     }
 }
@@ -211,8 +222,6 @@ impl Metrics {
 /// Computes every figure of [`Metrics`] for per-corner `uv` (index `3 f + k`).
 pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[[f64; 2]]) -> Metrics {
     let nf = mesh.n_faces();
-    let (distortion, scale, fraction_below_0_2, fraction_below_0_3, max_distortion) = distortion_figures(mesh, uv);
-
     let flipped = (0..nf).filter(|&f| !(signed_uv_area([uv[3 * f], uv[3 * f + 1], uv[3 * f + 2]]) > 0.0)).count();
 
     let (mut seam_angle, mut seam_len, mut seam_length) = (0.0f64, 0.0f64, 0.0);
@@ -243,11 +252,6 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
     }
     let wound_vertices = wound_vertices(mesh, placement, uv).len();
     Metrics {
-        distortion,
-        scale,
-        fraction_below_0_2,
-        fraction_below_0_3,
-        max_distortion,
         flipped,
         wound_vertices,
         seam_angle_residual: seam_angle,
@@ -257,6 +261,6 @@ pub fn compute(mesh: &TriMesh, placement: &ConePlacement, cut: &CutGraph, uv: &[
         boundary_corners: placement.boundary_corners.len(),
         seam_edges: cut.seam_edges.len(),
         seam_length,
-        faces: nf,
+        ..Metrics::of_distortion(mesh, uv)
     }
 }

@@ -251,9 +251,18 @@ impl Parts {
             metrics: Metrics::join(&parts_metrics, m, &uv),
             uv,
             seam_edges,
-            counts: solutions.iter().fold(ParamCounts::default(), |a, s| add_counts(a, &s.param.counts)),
+            counts: summed!(
+                ParamCounts,
+                solutions.iter().map(|s| &s.param.counts),
+                arap_iterations,
+                flips_before_repair,
+                flips_fixed,
+                repair_rounds,
+                refine_iterations,
+                untangle_iterations
+            ),
             realized_cones,
-            timings: solutions.iter().fold(ParamTimings::default(), |a, s| add_param_timings(a, &s.param.timings)),
+            timings: summed!(ParamTimings, solutions.iter().map(|s| &s.param.timings), cut, field, poisson, arap, repair, untangle, injective, metrics),
         };
         debug_assert!((0..m.n_edges() as u32).all(|e| {
             let (p, pe) = edge_at(e);
@@ -364,15 +373,7 @@ fn join_placements(m: &TriMesh, features: &FeatureSet, solutions: &[Solution<'_>
     let areas: Vec<f64> = solutions.iter().map(|s| s.mesh.face_areas().iter().sum()).collect();
     let total_area: f64 = areas.iter().sum();
     let phi2_area: f64 = solutions.iter().zip(&areas).map(|(s, a)| s.placement.phi_rms.powi(2) * a).sum();
-    let mut timings = ConeTimings::default();
-    for s in solutions {
-        let t = &s.placement.timings;
-        timings.cut += t.cut;
-        timings.topology += t.topology;
-        timings.rounding += t.rounding;
-        timings.cone_moves += t.cone_moves;
-        timings.total += t.total;
-    }
+    let timings = summed!(ConeTimings, solutions.iter().map(|s| &s.placement.timings), cut, topology, rounding, cone_moves, total);
     ConePlacement {
         cut,
         k,
@@ -388,29 +389,14 @@ fn join_placements(m: &TriMesh, features: &FeatureSet, solutions: &[Solution<'_>
     }
 }
 
-fn add_counts(a: ParamCounts, b: &ParamCounts) -> ParamCounts {
-    ParamCounts {
-        arap_iterations: a.arap_iterations + b.arap_iterations,
-        flips_before_repair: a.flips_before_repair + b.flips_before_repair,
-        flips_fixed: a.flips_fixed + b.flips_fixed,
-        repair_rounds: a.repair_rounds + b.repair_rounds,
-        refine_iterations: a.refine_iterations + b.refine_iterations,
-        untangle_iterations: a.untangle_iterations + b.untangle_iterations,
-    }
+/// A `$ty` whose every named field is the sum of that field over `$items`
+/// (an expression evaluated once per field).
+macro_rules! summed {
+    ($ty:ident, $items:expr, $($field:ident),+) => {
+        $ty { $($field: $items.map(|x| x.$field).sum(),)+ }
+    };
 }
-
-fn add_param_timings(a: ParamTimings, b: &ParamTimings) -> ParamTimings {
-    ParamTimings {
-        cut: a.cut + b.cut,
-        field: a.field + b.field,
-        poisson: a.poisson + b.poisson,
-        arap: a.arap + b.arap,
-        repair: a.repair + b.repair,
-        untangle: a.untangle + b.untangle,
-        injective: a.injective + b.injective,
-        metrics: a.metrics + b.metrics,
-    }
-}
+use summed;
 
 /// `message` with every vertex it names (`v` and digits, after a
 /// non-alphanumeric character) renamed through `vertex`.
