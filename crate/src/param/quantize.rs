@@ -1129,7 +1129,9 @@ impl Quantizer {
         let mut bad = self.badness(&x, s);
         let mut arap_iterations = 0;
         let mut untangled = false;
-        if bad > 0 {
+        // The untangler mends inverted triangles; a map whose only fault is a
+        // vertex it winds around twice has none to mend.
+        if (0..self.elements.len()).any(|f| self.collapsed(f, &x, s)) {
             // Untangle in model units (the barrier's area term wants det J ~ 1).
             let projector =
                 NullSpaceProjector::new(&system.c, self.n_unknowns, system.b.len()).ok();
