@@ -6,6 +6,8 @@
 //   (--big adds spot subdivided three times, 375 k faces, to native:scaling)
 //   browser:solve-big / browser:solve-single: Run in the page on 207 k faces with
 //   features, and on spot ×16 / fandisk ×16 without (issue 13's page targets)
+//   native:parts: a game asset of 56 parts copied 1, 4 and 16 times (64 with --big),
+//   solved with --quads: each part on its own, growth with the number of parts
 //   native:quads / wasm-node:quads: integer-grid quantization and quad extraction
 //   on fandisk (sharp > 60°) and spot at about 1 000, 3 000 and 10 000 quads
 //   (scripts/lib/bench-quads.mjs), with QuadriFlow's figures as static rows
@@ -315,11 +317,66 @@ function nativeScaling() {
     rows.push(solveRow('file → UVs', `spot.obj ×4^${levels}`, j));
     points.push([Math.log(j.faces), Math.log(j.timings.total)]);
   }
+  rows.push(growthRow('spot.obj family', points));
+  return rows;
+}
+
+/** The row of the exponent e of time ∝ faces^e fitted (least squares) to `points` ([log faces, log seconds]). */
+function growthRow(input, points) {
   const n = points.length;
   const mx = points.reduce((a, p) => a + p[0], 0) / n;
   const my = points.reduce((a, p) => a + p[1], 0) / n;
   const e = points.reduce((a, p) => a + (p[0] - mx) * (p[1] - my), 0) / points.reduce((a, p) => a + (p[0] - mx) ** 2, 0);
-  rows.push({ stage: 'growth exponent', input: 'spot.obj family', ms: NaN, note: `time ∝ faces^${e.toFixed(2)} (least squares over ${n} sizes)` });
+  return { stage: 'growth exponent', input, ms: NaN, note: `time ∝ faces^${e.toFixed(2)} (least squares over ${n} sizes)` };
+}
+
+/** `k` copies of `source` side by side (a grid of them, 1.2 widths apart) as one OBJ, cached like `subObj`. */
+function copiesObj(source, k) {
+  const dir = path.join(os.tmpdir(), 'conemap-bench');
+  const file = path.join(dir, `${path.basename(source, '.obj')}-x${k}.obj`);
+  if (fs.existsSync(file) && fs.statSync(file).mtimeMs >= fs.statSync(source).mtimeMs) return { file };
+  const { positions, triangles } = readObj(source);
+  let [lo, hi] = [Infinity, -Infinity];
+  for (let i = 0; i < positions.length; i += 3) [lo, hi] = [Math.min(lo, positions[i]), Math.max(hi, positions[i])];
+  const side = Math.ceil(Math.sqrt(k));
+  const step = 1.2 * (hi - lo);
+  const out = { positions: [], triangles: [] };
+  for (let c = 0; c < k; c++) {
+    const base = out.positions.length / 3;
+    for (let i = 0; i < positions.length; i += 3) {
+      out.positions.push(positions[i] + (c % side) * step, positions[i + 1], positions[i + 2] + Math.floor(c / side) * step);
+    }
+    for (const v of triangles) out.triangles.push(v + base);
+  }
+  fs.mkdirSync(dir, { recursive: true });
+  writeObj(out, `${file}.tmp`);
+  fs.renameSync(`${file}.tmp`, file);
+  return { file };
+}
+
+/**
+ * Many parts (a game asset: xatlas-gazebo, 56 components, 1, 4 and 16 copies
+ * side by side; 64 with --big): `solve --quads 3000·k --sharp 60`, each part
+ * solved and quantized on its own; a row per size and the growth exponent.
+ */
+function nativeParts() {
+  const gazebo = path.join(sharedMeshes, 'xatlas-gazebo.obj');
+  if (!fs.existsSync(gazebo)) return { skipped: `${gazebo} not found` };
+  const bin = releaseCli();
+  if (bin.skipped) return bin;
+  const rows = [];
+  const points = [];
+  for (const k of args.has('--big') ? [1, 4, 16, 64] : [1, 4, 16]) {
+    const { file } = k > 1 ? copiesObj(gazebo, k) : { file: gazebo };
+    const j = solveReport(bin, file, ['--sharp', '60', '--quads', String(3000 * k)]);
+    if (j.skipped) return j;
+    const row = solveRow('file → grid UVs', `xatlas-gazebo.obj ×${k} (${56 * k} parts)`, j);
+    const q = j.quantization;
+    row.note += `, quantize ${j.timings.quantize.toFixed(2)}; grid: ${q.flipped} flipped, ${q.wound_vertices} wound`;
+    rows.push(row);
+    points.push([Math.log(j.faces), Math.log(j.timings.total)]);
+  }
+  rows.push(growthRow('xatlas-gazebo.obj copies', points));
   return rows;
 }
 
@@ -690,6 +747,7 @@ const BENCHES = [
   { env: 'native', stage: 'solve', run: nativeSolve, enabled: !args.has('--no-native') },
   { env: 'native', stage: 'samples', run: nativeSamples, enabled: !args.has('--no-native') },
   { env: 'native', stage: 'scaling', run: nativeScaling, enabled: !args.has('--no-native') && !quick },
+  { env: 'native', stage: 'parts', run: nativeParts, enabled: !args.has('--no-native') && !quick },
   { env: 'native', stage: 'free-boundary', run: nativeFreeBoundary, enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'solve', run: wasmNodeSolve, enabled: true },
   { env: 'native', stage: 'quads', run: nativeQuads, enabled: !args.has('--no-native') },
