@@ -146,3 +146,14 @@ pub fn ring_with_flap(n: usize) -> TriMesh {
     }
     TriMesh::from_welded_arrays(p, t).unwrap()
 }
+
+/// A torus, an octahedron and a bent square side by side: three components.
+pub fn three_parts() -> TriMesh {
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for (k, part) in [torus(16, 10, 2.0, 0.7), octahedron(), grid(6, 6, |x, y| [x, y, 0.3 * x * y])].iter().enumerate() {
+        let base = positions.len() as u32;
+        positions.extend(part.positions().iter().map(|p| [p[0] + 5.0 * k as f64, p[1], p[2]]));
+        triangles.extend(part.faces().iter().map(|t| t.map(|v| v + base)));
+    }
+    TriMesh::from_welded_arrays(positions, triangles).unwrap()
+}

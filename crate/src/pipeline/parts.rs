@@ -425,6 +425,50 @@ fn relabel_vertices(message: &str, vertex: &[u32]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cones::test_meshes::three_parts;
+    use crate::pipeline::SolveCause;
+
+    /// Each part is its component of the input: positions, faces corner by
+    /// corner, edges and features through its maps; a part's error names
+    /// input elements.
+    #[test]
+    fn parts_are_the_components_of_the_input() {
+        let mesh = three_parts();
+        let mut features = FeatureSet::none(&mesh);
+        for e in (0..mesh.n_edges() as u32).step_by(7) {
+            features.set(&mesh, e, true);
+        }
+        let parts = Parts::split(&mesh, &features).expect("three components");
+        assert_eq!(parts.len(), 3);
+        let mut seen = vec![0; mesh.n_faces()];
+        for part in &parts.parts {
+            let m = &part.mesh;
+            assert_eq!(m.n_components(), 1);
+            for (v, &o) in part.vertex.iter().enumerate() {
+                assert_eq!(m.position(v as u32), mesh.position(o));
+            }
+            for (r, &f) in part.face.iter().enumerate() {
+                assert_eq!(m.faces()[r].map(|v| part.vertex[v as usize]), mesh.faces()[f as usize]);
+                seen[f as usize] += 1;
+            }
+            for (e, &o) in part.edge.iter().enumerate() {
+                let [a, b] = m.edge_vertices(e as u32).map(|v| part.vertex[v as usize]);
+                let [c, d] = mesh.edge_vertices(o);
+                assert!([a, b] == [c, d] || [a, b] == [d, c]);
+                assert_eq!(part.features.contains(e as u32), features.contains(o));
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1), "every face in one part");
+        let e = SolveError {
+            cause: SolveCause::Folded { flipped: 1, wound: 0, refinements: 0, faces: vec![0] },
+            located: Some((ErrorLocation { vertices: vec![0, 2], edges: vec![1] }, "folds at v0 and v2".into())),
+        };
+        let lifted = parts.lift_error(1, e);
+        let p = &parts.parts[1];
+        assert_eq!(lifted.location().unwrap().vertices, vec![p.vertex[0], p.vertex[2]]);
+        assert_eq!(lifted.location().unwrap().edges, vec![p.edge[1]]);
+        assert_eq!(lifted.to_string(), format!("folds at v{} and v{}", p.vertex[0], p.vertex[2]));
+    }
 
     #[test]
     fn messages_name_input_vertices() {

@@ -136,22 +136,10 @@ impl Part {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cones::test_meshes::{grid, octahedron, torus};
+    use crate::cones::test_meshes::three_parts;
     use crate::cones::{place_cones, ConeOptions};
     use crate::features::FeatureSet;
-    use crate::mesh::TriMesh;
     use crate::param::{parametrize, ParamOptions};
-
-    /// A torus, an octahedron and a bent square side by side: three parts.
-    fn three_parts() -> TriMesh {
-        let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-        for (k, part) in [torus(16, 10, 2.0, 0.7), octahedron(), grid(6, 6, |x, y| [x, y, 0.3 * x * y])].iter().enumerate() {
-            let base = positions.len() as u32;
-            positions.extend(part.positions().iter().map(|p| [p[0] + 5.0 * k as f64, p[1], p[2]]));
-            triangles.extend(part.faces().iter().map(|t| t.map(|v| v + base)));
-        }
-        TriMesh::from_welded_arrays(positions, triangles).unwrap()
-    }
 
     /// Every part's quantizer is the whole's restricted to the part: the
     /// same Jacobians, form values and kinds, seam rows, single-unknown
