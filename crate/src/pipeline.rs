@@ -12,6 +12,7 @@ use crate::clock::{now_seconds, Stopwatch};
 use crate::cones::{self, ComponentPlacement, ConeError, ConeOptions, ConePlacement, ConeProblem, MismatchError, RoundingRule};
 use crate::features::{refine_for_features_on, split_around, split_flipped, split_long_edges, FeatureSet, RefineCounts, Refined};
 use crate::mesh::TriMesh;
+use crate::param::quantize::GridSize;
 use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrization};
 use std::borrow::Cow;
 use std::fmt;
@@ -62,20 +63,41 @@ impl Default for RefineOptions {
 /// all shorter (spot, fandisk, teapot) are not touched.
 pub const QUAD_MAX_EDGE: f64 = 0.05;
 
+/// The longest edge the solve behind a quad mesh keeps, in quads (of the
+/// size asked for, or `sqrt(area / quads)`), where that is shorter than
+/// [`QUAD_MAX_EDGE`]: the diagonal of a scene grows with its objects, not
+/// its quads. Sixteen copies of a game asset side by side at 16 times the
+/// quads kept edges of 8 quads (287 defects, Euler characteristic off), the
+/// asset alone edges of 2.1 (none). 3.5 leaves every shared mesh at 3 000
+/// quads as [`QUAD_MAX_EDGE`] has it (gazebo 2.1, fandisk 2.7, cow 3.3 quads).
+pub const QUAD_MAX_EDGE_QUADS: f64 = 3.5;
+
 impl RefineOptions {
-    /// The default refinements plus, for a quad mesh of `mesh`, edges split
-    /// down to [`QUAD_MAX_EDGE`] of its bounding-box diagonal.
-    pub fn for_quads(mesh: &TriMesh) -> RefineOptions {
-        RefineOptions { max_edge_length: Some(QUAD_MAX_EDGE * mesh.bounding_diagonal()), ..RefineOptions::default() }
+    /// The default refinements plus, for a quad mesh of `mesh` with quads
+    /// of `grid`, edges split down to [`QUAD_MAX_EDGE`] of its bounding-box
+    /// diagonal or [`QUAD_MAX_EDGE_QUADS`] quads, whichever is shorter.
+    pub fn for_quads(mesh: &TriMesh, grid: GridSize) -> RefineOptions {
+        let quad = match grid {
+            GridSize::Length(s) => s,
+            GridSize::Quads(n) => (mesh.face_areas().iter().sum::<f64>() / n.max(1) as f64).sqrt(),
+        };
+        let (by_diagonal, by_quads) = (QUAD_MAX_EDGE * mesh.bounding_diagonal(), QUAD_MAX_EDGE_QUADS * quad);
+        // (A grid size that is not a positive length is the quantization's error to report.)
+        let length = if by_quads > 0.0 && by_quads.is_finite() { by_diagonal.min(by_quads) } else { by_diagonal };
+        RefineOptions { max_edge_length: Some(length), ..RefineOptions::default() }
     }
 }
 
 /// The settings to solve `mesh` again with when a map solved with `refine`
-/// is not fine enough (for quads, or because it folds on a low-poly mesh):
-/// `refine` asked for no maximum edge length and `mesh` has edges longer
-/// than [`QUAD_MAX_EDGE`] of its diagonal. `None`: keep the map as it is.
-pub fn long_edges_refine(mesh: &TriMesh, refine: &RefineOptions) -> Option<RefineOptions> {
-    let length = RefineOptions::for_quads(mesh).max_edge_length?;
+/// is not fine enough (for quads of `grid`, or, with `None`, because it
+/// folds on a low-poly mesh): `refine` asked for no maximum edge length and
+/// `mesh` has edges longer than [`RefineOptions::for_quads`] keeps (without
+/// a grid: [`QUAD_MAX_EDGE`] of its diagonal). `None`: keep the map as it is.
+pub fn long_edges_refine(mesh: &TriMesh, refine: &RefineOptions, grid: Option<GridSize>) -> Option<RefineOptions> {
+    let length = match grid {
+        Some(grid) => RefineOptions::for_quads(mesh, grid).max_edge_length?,
+        None => QUAD_MAX_EDGE * mesh.bounding_diagonal(),
+    };
     let long = (0..mesh.n_edges() as u32).any(|e| mesh.edge_length(e) > length);
     (refine.max_edge_length.is_none() && long).then_some(RefineOptions { max_edge_length: Some(length), ..*refine })
 }
@@ -806,7 +828,7 @@ impl Placed {
         // that still folds, split the longest edge of every face and solve
         // again, until the mesh is no longer low-poly.
         if folds && best.mesh.n_faces() < LOW_POLY_FACES {
-            if let Some(refine) = long_edges_refine(mesh, &options.refine) {
+            if let Some(refine) = long_edges_refine(mesh, &options.refine, None) {
                 if let Ok(solution) = solve(mesh, features, &SolveOptions { refine, ..options }, progress) {
                     return Ok(solution);
                 }

@@ -322,7 +322,7 @@ impl MeshSession {
         let (Some(input), Some(grid)) = (self.mesh.as_ref(), self.grid.as_mut()) else {
             return Err(JsError::new("solve the map before asking for quads").into());
         };
-        if let Some(refine) = pipeline::long_edges_refine(input, &grid.options.refine) {
+        if let Some(refine) = pipeline::long_edges_refine(input, &grid.options.refine, Some(GridSize::Quads(quads as usize))) {
             let options = SolveOptions { refine, ..grid.options };
             match pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)) {
                 Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, features: grid.features.clone(), options },

@@ -6,12 +6,12 @@
 use conemap::cones::ConeOptions;
 use conemap::features::FeatureSet;
 use conemap::pipeline::{solve, SolveOptions};
-use conemap::mesh::{RawMesh, TriMesh};
+use conemap::mesh::TriMesh;
 use conemap::param::{metrics::uv_angle_sums, ParamOptions};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 mod common;
-use common::{shared_mesh as load, shared_raw};
+use common::{shared_mesh as load, side_by_side};
 
 /// Solves `name` and checks the map; `max_flip_fraction` is the share of
 /// flipped triangles tolerated (0 except where a known shortfall is stated).
@@ -105,21 +105,6 @@ fn run_on(name: &str, input: &TriMesh, sharp: Option<f64>, max_distortion: f64, 
             sums[v as usize]
         );
     }
-}
-
-/// The shared meshes `names` side by side as one mesh (each moved clear of the ones before).
-fn side_by_side(names: &[&str]) -> TriMesh {
-    let mut raw = RawMesh { positions: Vec::new(), triangles: Vec::new() };
-    let mut x = 0.0;
-    for name in names {
-        let r = shared_raw(name);
-        let (lo, hi) = r.positions.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
-        let base = raw.positions.len() as u32;
-        raw.positions.extend(r.positions.iter().map(|p| [p[0] - lo + x, p[1], p[2]]));
-        raw.triangles.extend(r.triangles.iter().map(|t| t.map(|v| v + base)));
-        x += 1.1 * (hi - lo);
-    }
-    TriMesh::from_raw(&raw).unwrap()
 }
 
 /// A mesh of several components is solved one component at a time and the

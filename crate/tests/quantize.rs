@@ -434,7 +434,7 @@ fn a_low_poly_cad_cylinder_is_refined_for_quads() {
     let before = report(&plain, &extract_quads_along(&plain.mesh, &plain.features, &uv, &ExtractOptions::default()).unwrap());
     let far_singular = |r: &conemap::quads::QuadReport| r.singular_vertices.iter().filter(|v| !(3..=5).contains(&v.valence)).count();
     assert!(before.angle_mean_deviation > 12.0 && far_singular(&before) > 0, "the case this tests is gone: {before:?}");
-    let (refined, uv) = solve_with(RefineOptions::for_quads(&input));
+    let (refined, uv) = solve_with(RefineOptions::for_quads(&input, GridSize::Quads(1000)));
     let counts = refined.refinement;
     assert!(counts.long_edges > 0 && counts.coplanar_flips > 0, "{counts:?}");
     assert!(refined.mesh.n_faces() < 40 * input.n_faces(), "{} faces", refined.mesh.n_faces());
@@ -506,6 +506,31 @@ fn parts_thinner_than_a_cell_are_held_apart() {
     }
 }
 
+/// A scene of sixteen copies of the asset in a row: its diagonal is 16
+/// times the asset's, its quads too, so 5 % of the diagonal kept edges of
+/// 8 quads (287 defects, Euler characteristic off by 14); the refinement
+/// for quads also splits edges longer than `QUAD_MAX_EDGE_QUADS` quads,
+/// and the quad mesh is closed with every copy's topology.
+#[test]
+fn a_scene_of_copies_is_refined_by_its_quads() {
+    use conemap::pipeline::{RefineOptions, QUAD_MAX_EDGE, QUAD_MAX_EDGE_QUADS};
+    use conemap::quads::{check_quads, extract_quads_along, CheckOptions, ExtractOptions};
+    let input = common::side_by_side(&["xatlas-gazebo.obj"; 16]);
+    let grid = GridSize::Quads(16 * 3000);
+    let refine = RefineOptions::for_quads(&input, grid);
+    let area: f64 = input.face_areas().iter().sum();
+    let quad = (area / 48_000.0).sqrt();
+    assert_eq!(refine.max_edge_length, Some(QUAD_MAX_EDGE_QUADS * quad));
+    assert!(QUAD_MAX_EDGE * input.bounding_diagonal() > 2.0 * QUAD_MAX_EDGE_QUADS * quad, "the case this tests is gone");
+    let features = FeatureSet::sharp_edges(&input, 60.0);
+    let solution = solve(&input, &features, &SolveOptions { refine, ..SolveOptions::default() }, &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, grid, &mut |_, _| {}).unwrap();
+    let quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &ExtractOptions::default()).unwrap();
+    assert!(quads.defects.is_empty(), "{} defects: {:?}", quads.defects.len(), &quads.defects[..quads.defects.len().min(3)]);
+    let r = check_quads(&solution.mesh, &quads, &CheckOptions::default());
+    assert_eq!((r.euler_characteristic, r.boundary_loops), (16 * 111, 16), "{r:?}");
+}
+
 /// The same asset on the refinement the quads ask for (edges split to 5 %
 /// of the diagonal): three beams 0.58 cells thick kept a collapsed triangle
 /// in every pass over the whole mesh, though each beam alone rounds cleanly
@@ -516,7 +541,7 @@ fn parts_round_as_they_would_alone() {
     use conemap::pipeline::RefineOptions;
     let input = load("xatlas-gazebo.obj");
     let features = FeatureSet::none(&input);
-    let solution = solve(&input, &features, &SolveOptions { refine: RefineOptions::for_quads(&input), ..SolveOptions::default() }, &mut |_| {}).unwrap();
+    let solution = solve(&input, &features, &SolveOptions { refine: RefineOptions::for_quads(&input, GridSize::Quads(3000)), ..SolveOptions::default() }, &mut |_| {}).unwrap();
     assert!(solution.mesh.n_faces() > 4 * input.n_faces(), "{} faces", solution.mesh.n_faces());
     let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
     let r = &map.report;

@@ -29,6 +29,22 @@ pub fn shared_mesh(name: &str) -> TriMesh {
     TriMesh::from_raw(&shared_raw(name)).unwrap_or_else(|p| panic!("{name}: {}", p[0]))
 }
 
+/// The shared meshes `names` side by side as one mesh, each moved clear of
+/// the ones before along x (a name may come again: copies).
+pub fn side_by_side(names: &[&str]) -> TriMesh {
+    let mut raw = RawMesh { positions: Vec::new(), triangles: Vec::new() };
+    let mut x = 0.0;
+    for name in names {
+        let r = shared_raw(name);
+        let (lo, hi) = r.positions.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
+        let base = raw.positions.len() as u32;
+        raw.positions.extend(r.positions.iter().map(|p| [p[0] - lo + x, p[1], p[2]]));
+        raw.triangles.extend(r.triangles.iter().map(|t| t.map(|v| v + base)));
+        x += 1.1 * (hi - lo);
+    }
+    TriMesh::from_raw(&raw).unwrap()
+}
+
 /// Every mesh file (.obj, .gltf, .glb) of the shared folder, sorted by name;
 /// panics when the folder is absent or holds none.
 pub fn shared_files() -> Vec<PathBuf> {
