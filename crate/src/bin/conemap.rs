@@ -72,8 +72,9 @@ commands:
                        box diagonal), flipping edges between coplanar
                        triangles to keep them well shaped: more vertices
                        for the cones and the map on a low-poly mesh (a CAD
-                       export); default none (quads: 5%; solve splits to
-                       5% only where the map of a low-poly mesh folds).
+                       export); default none (quads: 5% or 3.5 quads,
+                       whichever is shorter; solve splits to 5% only where
+                       the map of a low-poly mesh folds).
                        --no-moves: skip the cone-location optimization
                        (with features, solve and quads otherwise also map
                        the placement without moves and keep the better
@@ -114,7 +115,8 @@ commands:
                        corner-angle statistics, distortion before and after
                        quantization, defects and per-stage timings. The
                        map is solved on the input refined to --max-edge 5%
-                       (the quads lie on the input surface all the same).
+                       or 3.5 quads, whichever is shorter (the quads lie on
+                       the input surface all the same).
 
 options:
   -h, --help           print this help
