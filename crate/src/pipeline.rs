@@ -506,6 +506,7 @@ pub enum SolveStage {
 }
 
 impl SolveStage {
+    /// The stage of `mesh`: one [`ConeStage`], or one per part where it has several components.
     pub fn new(mesh: &TriMesh, features: &FeatureSet, options: &SolveOptions) -> SolveStage {
         let Some(parts) = Parts::split(mesh, features) else {
             return SolveStage::One(ConeStage::new(mesh, features, options));
@@ -554,6 +555,9 @@ impl SolveStage {
         c: usize,
         progress: &mut dyn FnMut(cones::ConeProgress),
     ) -> Result<ComponentPlacement, SolveError> {
+        if c >= self.n_components() {
+            return Err(out_of_range(c));
+        }
         match self {
             SolveStage::One(stage) => stage.problem().place_component(c, progress).map_err(|e| stage.cone_error(mesh, features, e)),
             SolveStage::Parts { parts, stages, first } => {
@@ -589,7 +593,7 @@ impl SolveStage {
                 let mut of_part: Vec<Vec<ComponentPlacement>> = vec![Vec::new(); parts.len()];
                 for mut r in placed {
                     if r.component >= total {
-                        return Err(SolveError::unlocated(SolveCause::Components(MismatchError(format!("component {} is out of range", r.component)))));
+                        return Err(out_of_range(r.component));
                     }
                     let p = first.partition_point(|&f| f <= r.component) - 1;
                     r.component -= first[p];
@@ -608,6 +612,11 @@ impl SolveStage {
             }
         }
     }
+}
+
+/// Component `c` is not one of the stage's.
+fn out_of_range(c: usize) -> SolveError {
+    SolveError::unlocated(SolveCause::Components(MismatchError(format!("component {c} is out of range"))))
 }
 
 /// A finished cone stage, ready for [`Placed::parametrize`].
