@@ -20,6 +20,7 @@ pub mod features;
 pub mod io;
 pub mod linalg;
 pub mod mesh;
+pub mod parallel;
 pub mod pipeline;
 pub mod vec3;
 pub mod param;

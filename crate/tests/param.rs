@@ -26,16 +26,15 @@ fn run(name: &str, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f
 /// edge that is not a seam, and every feature edge asked for is aligned
 /// (on the input, through the refinement's maps).
 fn run_on(name: &str, input: &TriMesh, sharp: Option<f64>, max_distortion: f64, max_flip_fraction: f64) {
-    let input = input.clone();
     let features = match sharp {
-        Some(deg) => FeatureSet::sharp_edges(&input, deg),
-        None => FeatureSet::none(&input),
+        Some(deg) => FeatureSet::sharp_edges(input, deg),
+        None => FeatureSet::none(input),
     };
     let options = SolveOptions {
         cones: ConeOptions { alpha_smooth: 0.01, ..ConeOptions::default() },
         ..SolveOptions::default()
     };
-    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let solution = solve(input, &features, &options, &mut |_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
     let (mesh, placement, p) = (&*solution.mesh, &solution.placement, &solution.param);
     let m = &p.metrics;
     let t = &p.timings;
@@ -74,7 +73,7 @@ fn run_on(name: &str, input: &TriMesh, sharp: Option<f64>, max_distortion: f64, 
         let same = |a: u32, b: u32| p.uv[a as usize] == p.uv[b as usize];
         assert!(same(h, mesh.next(t)) && same(mesh.next(h), t), "{name}: the map is cut along edge {e}, not a seam");
     }
-    let alignment = solution.feature_alignment(&input, &features);
+    let alignment = solution.feature_alignment(input, &features);
     assert_eq!(alignment.aligned, alignment.requested, "{name}: {:?}", alignment.unaligned.first());
 
     // UV angle sums at interior vertices: 2 pi - k pi/2.

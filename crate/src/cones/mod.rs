@@ -274,34 +274,13 @@ pub fn place_cones(
 /// Places every component of `problem`, largest first; natively on two
 /// threads pulling from one queue, in wasm32 one after the other.
 pub fn place_all(problem: &ConeProblem, progress: &mut dyn FnMut(ConeProgress)) -> Result<Vec<ComponentPlacement>, ConeError> {
-    let order = problem.schedule();
-    #[cfg(not(target_arch = "wasm32"))]
-    if order.len() > 1 {
-        use std::sync::atomic::{AtomicUsize, Ordering};
-        let next = AtomicUsize::new(0);
-        let drain = |progress: &mut dyn FnMut(ConeProgress)| -> Result<Vec<ComponentPlacement>, ConeError> {
-            let mut out = Vec::new();
-            while let Some(&c) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
-                match problem.place_component(c, progress) {
-                    Ok(r) => out.push(r),
-                    Err(e) => {
-                        next.store(order.len(), Ordering::Relaxed); // the other thread stops too
-                        return Err(e);
-                    }
-                }
-            }
-            Ok(out)
-        };
-        return std::thread::scope(|scope| {
-            let helper = scope.spawn(|| drain(&mut |_| {}));
-            let mine = drain(progress);
-            let theirs = helper.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            let mut all = mine?;
-            all.extend(theirs?);
-            Ok(all)
-        });
-    }
-    order.iter().map(|&c| problem.place_component(c, progress)).collect()
+    let placed = crate::parallel::share_jobs(
+        &problem.schedule(),
+        |c| problem.place_component(c, &mut |_| {}),
+        |c| problem.place_component(c, progress),
+        Result::is_err,
+    );
+    placed.into_iter().map(|(_, r)| r).collect()
 }
 
 /// Cone indices on the input mesh from the cut-vertex integers: a vertex cut

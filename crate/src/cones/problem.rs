@@ -10,7 +10,7 @@ use super::system::{ComponentSystem, Weights};
 use super::{original_cones, BoundaryMode, ComponentFigures, ConeError, ConeOptions, ConePlacement, ConeTimings, ConeProgress};
 use crate::clock::Stopwatch;
 use crate::features::{boundary_turning, cut_open, CutMesh, FeatureSet};
-use crate::mesh::{decimate_interior, TriMesh};
+use crate::mesh::{decimate_interior, TriMesh, NONE};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -245,27 +245,8 @@ impl ConeProblem {
             return None;
         }
         // The component alone, numbered in order of first use.
-        let mut sub_id = vec![u32::MAX; cm.n_vertices()];
-        let mut sub_vertex = Vec::new();
-        let triangles: Vec<[u32; 3]> = sys
-            .tree
-            .faces
-            .iter()
-            .map(|&f| {
-                cm.faces()[f as usize].map(|v| {
-                    if sub_id[v as usize] == u32::MAX {
-                        sub_id[v as usize] = sub_vertex.len() as u32;
-                        sub_vertex.push(v);
-                    }
-                    sub_id[v as usize]
-                })
-            })
-            .collect();
-        let positions = sub_vertex.iter().map(|&v| cm.position(v)).collect();
-        let sub = TriMesh::from_welded_arrays(positions, triangles).ok()?;
-        if sub.n_vertices() != sub_vertex.len() {
-            return None;
-        }
+        let mut sub_id = vec![NONE; cm.n_vertices()];
+        let (sub, sub_vertex) = cm.submesh(&sys.tree.faces, &mut sub_id)?;
         // Levels, each a decimation of the previous to a quarter of its
         // interior (at least the coarse size): the cones settle at every scale.
         let mut levels: Vec<(TriMesh, Vec<u32>)> = Vec::new(); // (mesh, its vertices in `sub`)

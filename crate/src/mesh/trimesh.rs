@@ -74,6 +74,37 @@ impl TriMesh {
         Self::from_analysis(analyze_welded(&raw, Welded::by_index(&raw)))
     }
 
+    /// The faces `faces` of this mesh as a mesh of their own (a component,
+    /// say): vertices numbered in order of first use, faces and their
+    /// corners kept in order (halfedge `3 r + i` of it is halfedge
+    /// `3 faces[r] + i` here), and its vertex → this mesh's vertex. `local`
+    /// (one entry per vertex here) must hold [`NONE`] for the vertices of
+    /// `faces`; on return it holds their numbers in the new mesh. `None`
+    /// where the faces do not form a valid mesh on their own.
+    pub fn submesh(&self, faces: &[u32], local: &mut [u32]) -> Option<(TriMesh, Vec<u32>)> {
+        let mut vertex = Vec::new();
+        let triangles: Vec<[u32; 3]> = faces
+            .iter()
+            .map(|&f| {
+                self.faces[f as usize].map(|v| {
+                    if local[v as usize] == NONE {
+                        local[v as usize] = vertex.len() as u32;
+                        vertex.push(v);
+                    }
+                    local[v as usize]
+                })
+            })
+            .collect();
+        let positions = vertex.iter().map(|&v| self.positions[v as usize]).collect();
+        let sub = TriMesh::from_welded_arrays(positions, triangles).ok()?;
+        // Numbered as given (first use), unless the validation dropped something.
+        let same = sub.n_vertices() == vertex.len()
+            && sub.n_faces() == faces.len()
+            && sub.welded_to_source().iter().enumerate().all(|(i, &s)| s as usize == i)
+            && sub.faces().iter().zip(faces).all(|(t, &f)| t.map(|v| vertex[v as usize]) == self.faces[f as usize]);
+        same.then_some((sub, vertex))
+    }
+
     fn from_analysis(a: Analysis) -> Result<TriMesh, Vec<Problem>> {
         let blocking: Vec<Problem> = a.report.problems.iter().filter(|p| p.is_blocking()).cloned().collect();
         if !blocking.is_empty() {

@@ -61,28 +61,8 @@ impl Parts {
         let parts = faces_of
             .into_iter()
             .map(|face| {
-                let mut vertex = Vec::new();
-                let triangles: Vec<[u32; 3]> = face
-                    .iter()
-                    .map(|&f| {
-                        mesh.faces()[f as usize].map(|v| {
-                            if local[v as usize] == NONE {
-                                local[v as usize] = vertex.len() as u32;
-                                vertex.push(v);
-                            }
-                            local[v as usize]
-                        })
-                    })
-                    .collect();
-                let positions = vertex.iter().map(|&v| mesh.position(v)).collect();
-                // A component of a valid mesh is valid; the checks only guard the numbering.
-                let part = TriMesh::from_welded_arrays(positions, triangles).ok()?;
-                let vertex: Vec<u32> = part.welded_to_source().iter().map(|&s| vertex[s as usize]).collect();
-                let same = part.n_faces() == face.len()
-                    && part.faces().iter().zip(&face).all(|(t, &f)| t.map(|v| vertex[v as usize]) == mesh.faces()[f as usize]);
-                if !same {
-                    return None;
-                }
+                // A component of a valid mesh is valid.
+                let (part, vertex) = mesh.submesh(&face, &mut local)?;
                 let edge: Vec<u32> = (0..part.n_edges() as u32)
                     .map(|e| {
                         let h = face_halfedge(&part, e);
@@ -110,7 +90,7 @@ impl Parts {
     }
 
     /// Part indices, most faces first.
-    pub fn largest_first(&self) -> Vec<usize> {
+    fn largest_first(&self) -> Vec<usize> {
         let mut order: Vec<usize> = (0..self.parts.len()).collect();
         order.sort_by_key(|&p| std::cmp::Reverse(self.parts[p].mesh.n_faces()));
         order
@@ -130,26 +110,13 @@ impl Parts {
             let part = &self.parts[p];
             let started = now_seconds();
             let solution = super::solve_one(&part.mesh, &part.features, options, progress);
-            (p, solution, now_seconds() - started)
+            (solution, now_seconds() - started)
         };
-        #[cfg(not(target_arch = "wasm32"))]
-        let mut results = {
-            use std::sync::atomic::{AtomicUsize, Ordering};
-            let next = AtomicUsize::new(0);
-            let take = || order.get(next.fetch_add(1, Ordering::Relaxed)).copied();
-            std::thread::scope(|scope| {
-                let helper = scope.spawn(|| std::iter::from_fn(take).map(|p| solve(p, &mut |_| {})).collect::<Vec<_>>());
-                let mut mine: Vec<_> = std::iter::from_fn(take).map(|p| solve(p, progress)).collect();
-                mine.extend(helper.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
-                mine
-            })
-        };
-        #[cfg(target_arch = "wasm32")]
-        let mut results: Vec<_> = order.iter().map(|&p| solve(p, progress)).collect();
+        let mut results = crate::parallel::share_jobs(&order, |p| solve(p, &mut |_| {}), |p| solve(p, progress), |_| false);
         results.sort_by_key(|r| r.0);
-        let summed: f64 = results.iter().map(|r| r.2).sum();
+        let summed: f64 = results.iter().map(|r| r.1 .1).sum();
         let wall_share = ((now_seconds() - started) / summed.max(f64::MIN_POSITIVE)).min(1.0);
-        let solutions = results.into_iter().map(|(p, r, _)| r.map_err(|e| self.lift_error(p, e))).collect::<Result<_, _>>()?;
+        let solutions = results.into_iter().map(|(p, (r, _))| r.map_err(|e| self.lift_error(p, e))).collect::<Result<_, _>>()?;
         Ok((solutions, wall_share))
     }
 
