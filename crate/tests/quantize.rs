@@ -506,6 +506,57 @@ fn parts_thinner_than_a_cell_are_held_apart() {
     }
 }
 
+/// One of the asset's braces alone (a slanted box 0.22 by 0.9 by 0.7, its
+/// edges sharper than 60° as features), turned and moved to twelve places,
+/// at grid lengths 0.20 to 0.29: the box is thinner than a cell, and its
+/// seams add the gaps of two held pairs into a third, so with every held
+/// row at one line the third's row is dependent and its pair lands on one
+/// grid line (4 of the 120 maps folded). Widening a held row by a line
+/// parts all three.
+#[test]
+fn held_rows_widen_where_seams_add_their_gaps() {
+    let brace: [[f64; 3]; 8] = [
+        [13.425371, 0.112689, -0.746624],
+        [13.582747, 1.00861, -0.057324],
+        [13.401802, 1.00861, -0.057324],
+        [13.622736, 0.336135, -0.765051],
+        [13.582747, 1.00861, -0.23827],
+        [13.425371, 0.336135, -0.746624],
+        [13.401802, 1.00861, -0.23827],
+        [13.622736, 0.112689, -0.765051],
+    ];
+    let triangles: Vec<[u32; 3]> = [[1, 2, 3], [2, 4, 5], [5, 6, 7], [6, 3, 7], [6, 8, 1], [3, 5, 7], [1, 8, 2], [2, 8, 4], [5, 4, 6], [6, 1, 3], [6, 4, 8], [3, 2, 5]]
+        .iter()
+        .map(|t| t.map(|i| i - 1))
+        .collect();
+    let mut widened = 0;
+    for place in 0..12 {
+        let a = [0.7 * place as f64, 1.3 * place as f64 + 0.4, 2.1 * place as f64 + 0.9];
+        let turn = |p: [f64; 3]| {
+            let (c, s) = (a[0].cos(), a[0].sin());
+            let p = [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2]];
+            let (c, s) = (a[1].cos(), a[1].sin());
+            let p = [c * p[0] + s * p[2], p[1], -s * p[0] + c * p[2]];
+            let (c, s) = (a[2].cos(), a[2].sin());
+            [c * p[0] - s * p[1] + 3.0 * place as f64, s * p[0] + c * p[1] - 1.7 * place as f64, p[2] + 0.37]
+        };
+        let mesh = TriMesh::from_welded_arrays(brace.iter().map(|&p| turn(p)).collect(), triangles.clone()).unwrap();
+        let features = FeatureSet::sharp_edges(&mesh, 60.0);
+        let solution = solve(&mesh, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+        let quantizer = solution.quantizer().unwrap();
+        for step in 0..10 {
+            let grid = 0.20 + 0.01 * step as f64;
+            let map = quantizer.quantize(&solution.mesh, GridSize::Length(grid), &mut |_, _| {}).unwrap();
+            let r = &map.report;
+            assert_eq!((r.conflicts, r.flipped, r.separations_violated), (0, 0, 0), "place {place}, grid {grid}: {r:?}");
+            let (flipped, off_grid, _) = check_integer_grid_counting_cones("brace", &solution.mesh, &solution.features, &map.uv);
+            assert_eq!((flipped, off_grid), (0, 0), "place {place}, grid {grid}");
+            widened += (r.separations_widened > 0) as usize;
+        }
+    }
+    assert!(widened > 0, "the case this tests is gone");
+}
+
 /// A scene of sixteen copies of the asset in a row: its diagonal is 16
 /// times the asset's, its quads too, so 5 % of the diagonal kept edges of
 /// 8 quads (287 defects, Euler characteristic off by 14); the refinement

@@ -245,6 +245,8 @@ export interface QuantizeReport {
   separations_violated: number;
   /** Separations held as rows of the solves in the pass kept (0 unless the map was still bad after the plain and stiffer passes). */
   separations_held: number;
+  /** Of those, rows widened to more than one grid line so that the pairs the seams make them determine are parted too. */
+  separations_widened: number;
   /** Ends of feature curves inside the mesh, and those left off the grid points (their curve shorter than a cell). */
   curve_ends: number;
   free_curve_ends: number;
@@ -331,7 +333,7 @@ export interface QuadsResult {
 
 export const QUANTIZE_REPORT_KEYS = {
   grid_size: true, point_forms: true, translation_forms: true, batches: true, separation_moves: true, separations: true,
-  separations_violated: true, separations_held: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiff_weight: true,
+  separations_violated: true, separations_held: true, separations_widened: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiff_weight: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
   wound_vertices: true, cells: true, seconds: true,
 } as const satisfies Keys<QuantizeReport>;

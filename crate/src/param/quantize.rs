@@ -50,6 +50,12 @@
 //! (where a cell is wider than a part of the surface, a plank or a box
 //! thinner than a cell, the moves of [`Quantizer::separate`] one integer
 //! at a time cannot undo the collapse: each breaks the neighbouring pairs).
+//! Held at exactly one line, some pairs cannot all part (a box's seams add
+//! the gaps of two pairs into a third, whose row is then dropped as
+//! dependent); where the held pass leaves such pairs and the map bad, it
+//! runs again with held rows widened to two lines where that parts them
+//! ([`Quantizer::widen_held`]: the separations are inequalities), kept
+//! only if it has fewer faults of both kinds ([`keep_dominant`]).
 //! Where it is still bad and a quad count was asked, grids a few percent
 //! larger and smaller ([`RETRY_GRID_FACTORS`]).
 //!
@@ -59,9 +65,10 @@
 //! the parts are shared between two threads.
 //!
 //! Cost: one symbolic analysis and numeric factorization of the KKT per
-//! batch (the rows change; about ten batches), and up to seven passes where
-//! the plain fit leaves the map bad (the held pass: up to [`HOLD_ROUNDS`]
-//! more factorizations before its first batch). With that factorization:
+//! batch (the rows change; about ten batches), and up to eight passes where
+//! the plain fit leaves the map bad, ten where the widened pass does best
+//! (the held pass: up to [`HOLD_ROUNDS`] more factorizations before its
+//! first batch, and at most [`WIDEN_TRIALS`] solves widening). With that factorization:
 //! one adjoint solve per violated separation and one solve per move tried
 //! (at most [`SEPARATION_TRIALS`] per batch, fewer on large meshes:
 //! [`FULL_BUDGET_FACES`]); after the last batch, one
@@ -177,6 +184,10 @@ const STIFF_PASS_LIMIT: usize = 16;
 /// holding the separations the one before left violated ([`HeldApart`]).
 const HOLD_ROUNDS: usize = 3;
 
+/// Held rows the held pass may try widened by a line before its first batch
+/// ([`Quantizer::widen_held`]; a share on large meshes, [`Quantizer::budget`]).
+const WIDEN_TRIALS: usize = 32;
+
 /// Meshes up to this many faces get the full budgets of extra solves
 /// ([`SEPARATION_TRIALS`], [`UNCOLLAPSE_TRIALS`], [`UNCOLLAPSE_PROBES`] and
 /// the untangler's default iterations); larger ones a share `FULL_BUDGET_FACES
@@ -281,8 +292,10 @@ pub struct QuantizeReport {
     pub separations: usize,
     pub separations_violated: usize,
     /// Separations held as rows in the pass kept (0 unless the held pass
-    /// was run and kept: [`HeldApart`]).
+    /// was run and kept: [`HeldApart`]), and those of them widened to
+    /// more than one line so that dependent ones part too.
     pub separations_held: usize,
+    pub separations_widened: usize,
     /// Ends of feature curves inside the mesh, and those left off the grid
     /// points (their curve shorter than a cell).
     pub curve_ends: usize,
@@ -510,7 +523,7 @@ impl Quantizer {
         } else {
             self.round_parts(s, retry, options, progress)?
         };
-        let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_held, separations_violated, free_curve_ends, .. } = rounded;
+        let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_held, separations_widened, separations_violated, free_curve_ends, .. } = rounded;
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
             if let (FormKind::Cone | FormKind::Point, [(i, 1)], Some(v)) =
@@ -556,6 +569,7 @@ impl Quantizer {
             separation_moves,
             separations,
             separations_held,
+            separations_widened,
             separations_violated,
             curve_ends: self.curve_ends.len(),
             free_curve_ends,
@@ -607,24 +621,41 @@ impl Quantizer {
         let held_pass = |b: &Rounded| b.collapsed + b.wound > 0 && (b.separations_violated > 0 || b.collapsed + b.wound <= STIFF_PASS_LIMIT);
         if best.as_ref().is_some_and(|(b, _)| held_pass(b)) {
             let fit = Fit::new(&self.elements, &stiff, 1.0);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true }, progress)?;
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, widen: false }, progress)?;
+            // Where the held rows could not part every held pair (rows dropped
+            // as dependent), the same with rows widened: another trajectory
+            // of the rounding, kept only if it ends better.
+            let widen = rounded.held_dropped > 0 && rounded.collapsed + rounded.wound > 0;
             keep_better(&mut best, rounded, s);
+            if widen {
+                let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, widen: true }, progress)?;
+                keep_dominant(&mut best, rounded, s);
+            }
         }
         // A quad count only asks for about so many quads: where the map
         // still folds, nearby grid lengths round differently and often
-        // cleanly (holding the separations where the held pass did best).
+        // cleanly (holding the separations where a held pass did best; where
+        // the widened one did, both held and widened: each length rounds its
+        // own way).
         let mut fit = None;
         for factor in RETRY_GRID_FACTORS.into_iter().filter(|_| retry) {
-            if best.as_ref().is_some_and(|(b, _)| b.collapsed == 0 && (b.wound == 0 || !options.retry_wound)) {
+            let Some((b, _)) = best.as_ref() else { break };
+            if b.collapsed == 0 && (b.wound == 0 || !options.retry_wound) {
                 break;
             }
-            let hold = best.as_ref().is_some_and(|(b, _)| b.separations_held > 0);
+            let (held, best_pass) = (Pass { hold: b.separations_held > 0, widen: false }, b.pass);
             let s_retry = s * factor;
             let (x0, targets) = start(s_retry);
             let rules = self.size_rules(&x0, s_retry);
             let fit = fit.get_or_insert_with(|| Fit::new(&self.elements, &stiff, 1.0));
-            let rounded = self.round_and_polish(fit, &x0, &targets, s_retry, &rules, Pass { hold }, progress)?;
-            keep_better(&mut best, rounded, s_retry);
+            for pass in [held, best_pass].into_iter().take(if best_pass.widen { 2 } else { 1 }) {
+                let rounded = self.round_and_polish(fit, &x0, &targets, s_retry, &rules, pass, progress)?;
+                if pass.widen {
+                    keep_dominant(&mut best, rounded, s_retry);
+                } else {
+                    keep_better(&mut best, rounded, s_retry);
+                }
+            }
         }
         Ok(best.expect("at least one pass"))
     }
@@ -662,6 +693,7 @@ impl Quantizer {
             joined.collapsed += r.collapsed;
             joined.separations += r.separations;
             joined.separations_held += r.separations_held;
+            joined.separations_widened += r.separations_widened;
             joined.separations_violated += r.separations_violated;
             joined.free_curve_ends += r.free_curve_ends;
         }
@@ -752,12 +784,23 @@ impl Quantizer {
         let mut separation_moves = 0;
         let mut system = None;
         let mut held = HeldApart::default();
+        let mut held_dropped = 0;
         if pass.hold {
+            let mut relaxed = None;
             for _ in 0..HOLD_ROUNDS {
                 if held.hold_violated(separations, &x, NEAR_INTEGER) == 0 {
                     break;
                 }
-                x = self.solve(fit, &order, &values, &x, targets, &held.list)?.0.x;
+                let solved = self.solve(fit, &order, &values, &x, targets, &held)?.0;
+                x = solved.x.clone();
+                relaxed = Some(solved);
+            }
+            if let Some(mut relaxed) = relaxed {
+                held_dropped = held.violated(&relaxed.x, NEAR_INTEGER).len();
+                if pass.widen {
+                    self.widen_held(&mut relaxed, &mut held, x0, targets)?;
+                }
+                x = relaxed.x;
             }
         }
         for kind in [FormKind::Cone, FormKind::Point, FormKind::Translation] {
@@ -786,7 +829,7 @@ impl Quantizer {
                     }
                     order.truncate(before);
                     order.extend(&batch);
-                    let (solved, dependent) = self.solve(fit, &order, &values, &x, targets, &held.list)?;
+                    let (solved, dependent) = self.solve(fit, &order, &values, &x, targets, &held)?;
                     // A candidate the others determine at a non-integer value (a
                     // dependency with coefficient 1/2 the kind order missed): round
                     // it first instead, so that it determines them.
@@ -872,6 +915,9 @@ impl Quantizer {
             stiff_weight: fit.stiff_weight,
             separations: separations.list.len(),
             separations_held: held.list.len(),
+            separations_widened: held.gaps.iter().filter(|&&g| g > 1).count(),
+            held_dropped,
+            pass,
             separations_violated,
             free_curve_ends: self.curve_ends.iter().filter(|end| end.free_at(s)).count(),
         })
@@ -1312,10 +1358,68 @@ impl Quantizer {
             .count()
     }
 
+    /// Widens held rows so that the pairs whose rows the solve dropped are
+    /// parted too. On a box thinner than a cell the seams add the gaps of two
+    /// held pairs into a third (`x27 - x28 = (x10 - x11) - (x0 - x2)`): at
+    /// gap 1 each, the third's row is dependent and its pair left on one
+    /// line, though as the inequalities they are (gap >= 1) all three can
+    /// hold (one gap of 2). For each such pair of the relaxed map
+    /// `system.x`, its gap's change per unit change of every held row comes
+    /// from one adjoint solve ([`RoundedSystem::sensitivity`]); the held
+    /// rows that widen it, least stretched first, are tried a line wider
+    /// (two where it gains a half per line), each one solve with the same
+    /// factorization; a trial is kept when fewer held pairs stay violated.
+    /// At most [`Self::budget`]`(WIDEN_TRIALS)` solves. Returns the rows widened.
+    fn widen_held(&self, system: &mut RoundedSystem, held: &mut HeldApart, x0: &[f64], targets: &[[[f64; 2]; 2]]) -> Result<usize, QuantizeError> {
+        let mut violated = held.violated(&system.x, NEAR_INTEGER);
+        let (mut trials, max_trials, mut widened) = (0, self.budget(WIDEN_TRIALS), 0);
+        for pair in violated.clone() {
+            if !violated.contains(&pair) {
+                continue;
+            }
+            if trials >= max_trials {
+                break;
+            }
+            trials += 1;
+            let gain = system.sensitivity(&[(pair.hi, 1), (pair.lo, -1)])?;
+            let mut candidates: Vec<(f64, usize, usize, i64)> = system
+                .held_rows
+                .iter()
+                .filter(|&&(k, _)| held.list[k] != pair)
+                .filter_map(|&(k, row)| {
+                    let g = gain[row];
+                    (g > 0.25).then(|| {
+                        let step = if g > 0.75 { 1 } else { 2 };
+                        let sep = held.list[k];
+                        ((held.gaps[k] + step) as f64 - (x0[sep.hi] - x0[sep.lo]), k, row, step)
+                    })
+                })
+                .collect();
+            candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for (_, k, row, step) in candidates.into_iter().take(CANDIDATES_PER_SEPARATION) {
+                if trials >= max_trials {
+                    break;
+                }
+                trials += 1;
+                system.b[row] += step as f64;
+                let x = system.resolve(self, targets)?;
+                let after = held.violated(&x, NEAR_INTEGER);
+                if after.len() < violated.len() {
+                    (system.x, violated) = (x, after);
+                    held.gaps[k] += step;
+                    widened += 1;
+                    break;
+                }
+                system.b[row] -= step as f64;
+            }
+        }
+        Ok(widened)
+    }
+
     /// Factors the KKT of the seam rows, the rounded forms `order` (their
     /// values in `values`), the gauge pins each component still needs
-    /// (held at `x`'s values) and the separations `held` (`x_hi - x_lo = 1`,
-    /// left out where the rows before determine them), and solves for the
+    /// (held at `x`'s values) and the separations `held` (`x_hi - x_lo =
+    /// gap`, left out where the rows before determine them), and solves for the
     /// map closest to `targets`. Also returns the forms of `order` left out
     /// because the earlier rows determine them.
     fn solve(
@@ -1325,7 +1429,7 @@ impl Quantizer {
         values: &[Option<i64>],
         x: &[f64],
         targets: &[[[f64; 2]; 2]],
-        held: &[Separation],
+        held: &HeldApart,
     ) -> Result<(RoundedSystem, Vec<usize>), QuantizeError> {
         let mut rows = self.seam_rows.clone();
         let mut rhs_rows = vec![0.0; rows.len()];
@@ -1346,9 +1450,10 @@ impl Quantizer {
             rows.push(vec![(unknown, 1)]);
             rhs_rows.push(x[unknown]);
         }
-        for sep in held {
+        let n_held_from = rows.len();
+        for (sep, &gap) in held.list.iter().zip(&held.gaps) {
             rows.push(vec![(sep.hi, 1), (sep.lo, -1)]);
-            rhs_rows.push(1.0);
+            rhs_rows.push(gap as f64);
         }
         let keep = independent_rows(&rows, self.n_unknowns);
         let n_seam = self.seam_rows.len();
@@ -1360,11 +1465,14 @@ impl Quantizer {
             .collect();
         let mut c = Vec::new();
         let mut b = Vec::new();
-        let mut form_rows = Vec::new();
+        let (mut form_rows, mut held_rows) = (Vec::new(), Vec::new());
         for (r, ((row, k), v)) in rows.iter().zip(keep).zip(rhs_rows).enumerate() {
             if k {
                 if (n_seam..n_seam + order.len()).contains(&r) {
                     form_rows.push((order[r - n_seam], b.len()));
+                }
+                if r >= n_held_from {
+                    held_rows.push((r - n_held_from, b.len()));
                 }
                 c.extend(row.iter().map(|&(i, a)| (b.len(), i, a as f64)));
                 b.push(v);
@@ -1378,6 +1486,7 @@ impl Quantizer {
             c,
             b,
             form_rows,
+            held_rows,
             n: self.n_unknowns,
             x: Vec::new(),
         };
@@ -1424,16 +1533,24 @@ struct Rounded {
     /// and those `x` leaves violated.
     separations: usize,
     separations_held: usize,
+    separations_widened: usize,
     separations_violated: usize,
+    /// Held pairs the relaxed map left violated (their rows dependent on
+    /// the others) before any widening.
+    held_dropped: usize,
+    pass: Pass,
     /// Ends of feature curves left off the grid points at its grid size.
     free_curve_ends: usize,
 }
 
 /// How a pass of [`Quantizer::round_and_polish`] rounds: with `hold`,
-/// holding the separations it leaves violated as rows ([`HeldApart`]).
+/// holding the separations it leaves violated as rows ([`HeldApart`]);
+/// with `widen` too, widening held rows so that the held pairs whose rows
+/// are dependent are parted as well ([`Quantizer::widen_held`]).
 #[derive(Clone, Copy, Default)]
 struct Pass {
     hold: bool,
+    widen: bool,
 }
 
 /// What quantization at one grid size keeps to beyond the forms.
@@ -1463,6 +1580,8 @@ struct RoundedSystem {
     b: Vec<f64>,
     /// The rows of `c` that are rounded forms: (form, row).
     form_rows: Vec<(usize, usize)>,
+    /// The rows of `c` that are held separations: (index in [`HeldApart`], row).
+    held_rows: Vec<(usize, usize)>,
     n: usize,
     x: Vec<f64>,
 }
@@ -1535,6 +1654,20 @@ impl RoundedSystem {
 fn keep_better(best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64) {
     let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
     if best.as_ref().is_none_or(|(b, _)| key(&candidate) < key(b)) {
+        *best = Some((candidate, s));
+    }
+}
+
+/// Keeps `candidate` (rounded at grid length `s`) over `best` only where it
+/// has no more collapsed faces and no more wound vertices, and fewer of
+/// both together: a pass that widens held rows stretches the map (more
+/// cells, more distortion), so it has to mend the map, not trade one fault
+/// for another.
+fn keep_dominant(best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64) {
+    let dominates = best.as_ref().is_none_or(|(b, _)| {
+        candidate.collapsed <= b.collapsed && candidate.wound <= b.wound && candidate.collapsed + candidate.wound < b.collapsed + b.wound
+    });
+    if dominates {
         *best = Some((candidate, s));
     }
 }

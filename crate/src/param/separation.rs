@@ -203,14 +203,16 @@ impl Separations {
     }
 }
 
-/// The separations held as rows `x_hi - x_lo = 1` of a pass's solves: each
-/// joins once a solve leaves its pair less than a grid line apart, integers
-/// or not, and stays (an active set that only grows: a pair pushed apart to
-/// one grid line would go back without its row). The rows are dropped by
-/// the solve once the rounded forms determine both unknowns.
+/// The separations held as rows `x_hi - x_lo = gap` of a pass's solves
+/// (`gap` an integer, 1 unless widened): each joins once a solve leaves its
+/// pair less than a grid line apart, integers or not, and stays (an active
+/// set that only grows: a pair pushed apart to one grid line would go back
+/// without its row). The rows are dropped by the solve once the rounded
+/// forms determine both unknowns.
 #[derive(Default)]
 pub(super) struct HeldApart {
     pub list: Vec<Separation>,
+    pub gaps: Vec<i64>,
     set: HashSet<Separation>,
 }
 
@@ -223,9 +225,16 @@ impl HeldApart {
         for &sep in &separations.list {
             if x[sep.hi] - x[sep.lo] < 1.0 - near && self.set.insert(sep) {
                 self.list.push(sep);
+                self.gaps.push(1);
             }
         }
         self.list.len() - before
+    }
+
+    /// The held pairs `x` leaves less than a grid line apart (by more than
+    /// `near`): the rows the solve dropped as dependent on the others.
+    pub fn violated(&self, x: &[f64], near: f64) -> Vec<Separation> {
+        self.list.iter().copied().filter(|s| x[s.hi] - x[s.lo] < 1.0 - near).collect()
     }
 }
 
