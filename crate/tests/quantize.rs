@@ -217,20 +217,30 @@ fn forms_determined_at_half_integers_are_made_integers() {
 
 /// A UV map's integer-grid map that winds around a vertex (no flipped
 /// triangle) shows a singular point off the grid; with `retry_wound` it is
-/// rounded again at nearby grid sizes (the cow at 3 000 cells: 2 such
-/// vertices at the asked length, none at 0.97 of it).
+/// rounded again at nearby grid sizes and the map with fewer faults kept.
+/// The cow at 3 000 cells wound around 2 vertices at the asked length and
+/// none at 0.97 of it until the held pass widened its rows; it is now clean
+/// at the asked length. At 1 500 cells it winds around 2 vertices at all
+/// three lengths: the map kept is no worse than the plain one and still an
+/// integer-grid map away from those vertices.
 #[test]
 fn uv_grid_maps_round_again_where_they_wind_around_vertices() {
     let cow = load("cow.obj");
     let features = FeatureSet::none(&cow);
     let solution = solve(&cow, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
     let quantizer = solution.quantizer().unwrap();
-    let plain = quantizer.quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
-    assert!(plain.report.wound_vertices > 0, "the case this test is about: {:?}", plain.report);
+    let clean = quantizer.quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
+    assert_eq!((clean.report.flipped, clean.report.wound_vertices), (0, 0), "{:?}", clean.report);
+    let plain = quantizer.quantize(&solution.mesh, GridSize::Quads(1500), &mut |_, _| {}).unwrap();
+    assert!(plain.report.flipped == 0 && plain.report.wound_vertices > 0, "the case this test is about: {:?}", plain.report);
     let options = QuantizeOptions { retry_wound: true };
-    let map = quantizer.quantize_with(&solution.mesh, GridSize::Quads(3000), &options, &mut |_, _| {}).unwrap();
-    assert_eq!((map.report.flipped, map.report.wound_vertices), (0, 0), "{:?}", map.report);
-    assert_eq!(check_integer_grid("cow", &solution.mesh, &solution.features, &map.uv), (0, 0));
+    let map = quantizer.quantize_with(&solution.mesh, GridSize::Quads(1500), &options, &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert!((r.flipped, r.wound_vertices) <= (plain.report.flipped, plain.report.wound_vertices), "{r:?}");
+    assert!((r.grid_size / plain.report.grid_size - 1.0).abs() <= 0.031 && r.conflicts == 0, "{r:?}");
+    // A vertex the map winds around is a singular point off the grid: no other is.
+    let (flipped, off_grid) = check_integer_grid("cow", &solution.mesh, &solution.features, &map.uv);
+    assert!(flipped == 0 && off_grid <= r.wound_vertices, "{flipped} flipped, {off_grid} off the grid: {r:?}");
 }
 
 #[test]
@@ -336,19 +346,21 @@ fn stiffer_fit_around_cones_mends_coarse_grids() {
     assert!(r.angle_mean_deviation < 7.0, "fandisk: mean corner-angle deviation {}", r.angle_mean_deviation);
 }
 
-/// Where the coarse map winds twice around a point (fandisk > 60° at 1 000
-/// quads: three cells of 8 sides, each an isoline traced out and back plus
-/// a hexagon), the extractor closes the mesh instead of leaving holes: each
-/// hexagon becomes three quads around an input vertex, and the quad mesh is
-/// closed, manifold, one piece, with the input's Euler characteristic; the
-/// report says where.
+/// Where the map winds twice around a point with no flipped triangle
+/// (spot > 40° at 3 000 quads: two such vertices; fandisk > 60° at 1 000
+/// was the case until the held pass widened its rows), the extractor
+/// closes the mesh instead of leaving holes: each cell traced around twice
+/// becomes quads around an input vertex, and the quad mesh is closed,
+/// manifold, one piece, with the input's Euler characteristic; the report
+/// says where.
 #[test]
 fn cells_the_map_winds_around_are_closed_with_quads() {
     use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
-    let input = load("fandisk.obj");
-    let features = FeatureSet::sharp_edges(&input, 60.0);
+    let input = load("spot.obj");
+    let features = FeatureSet::sharp_edges(&input, 40.0);
     let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
-    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1000), &mut |_, _| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
+    assert_eq!(map.report.flipped, 0, "{:?}", map.report);
     assert!(map.report.wound_vertices > 0, "the case this tests is gone: {:?}", map.report);
     let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
     assert!(!quads.defects.is_empty());
@@ -379,32 +391,35 @@ fn quantizer_reruns_for_another_size() {
 }
 
 
-/// With scattered features (spot at `--sharp 40`, 1 500 quads) the
-/// rounding at the asked grid length folds the map; with a quad count the
-/// quantizer also rounds at grid lengths a few percent off and keeps the
-/// map with fewer flips, while an explicit length is kept exactly. What is
-/// left (cells the map winds around) the extractor closes: the quad mesh
-/// is closed with the input's Euler characteristic.
+/// The cow without features at 2 000 quads: the rounding at the asked grid
+/// length folds the map; with a quad count the quantizer also rounds at
+/// grid lengths a few percent off and keeps the map with fewer flips (here
+/// none), while an explicit length is kept exactly. The quad mesh of that
+/// map is clean, with the input's Euler characteristic. (Spot at `--sharp
+/// 40`, 1 500 quads, was the case until the held pass widened its rows:
+/// now the asked length and its neighbours all leave 2 flipped.)
 #[test]
 fn nearby_grid_sizes_mend_a_folding_rounding() {
     use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
-    let input = load("spot.obj");
-    let features = FeatureSet::sharp_edges(&input, 40.0);
+    let input = load("cow.obj");
+    let features = FeatureSet::none(&input);
     let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
     let quantizer = solution.quantizer().unwrap();
-    let s = quantizer.grid_length(GridSize::Quads(1500)).unwrap();
+    let s = quantizer.grid_length(GridSize::Quads(2000)).unwrap();
     let exact = quantizer.quantize(&solution.mesh, GridSize::Length(s), &mut |_, _| {}).unwrap();
     assert_eq!(exact.report.grid_size, s);
     assert!(exact.report.flipped > 0, "the case this tests is gone: {:?}", exact.report);
-    let count = quantizer.quantize(&solution.mesh, GridSize::Quads(1500), &mut |_, _| {}).unwrap();
+    let count = quantizer.quantize(&solution.mesh, GridSize::Quads(2000), &mut |_, _| {}).unwrap();
     let r = &count.report;
     assert!(r.flipped < exact.report.flipped, "{} flipped, {} at the asked length", r.flipped, exact.report.flipped);
     assert!(r.grid_size != s && (r.grid_size / s - 1.0).abs() <= 0.031, "grid {} against {s}", r.grid_size);
-    assert_eq!(r.conflicts, 0);
+    assert_eq!((r.conflicts, r.flipped, r.wound_vertices), (0, 0, 0), "{r:?}");
+    assert_eq!(check_integer_grid("cow", &solution.mesh, &solution.features, &count.uv), (0, 0));
     let quads = extract_quads(&solution.mesh, &count.uv, &ExtractOptions::default()).unwrap();
-    assert!(!quads.defects.is_empty() && quads.defects.iter().all(|d| d.what.contains("closed")), "{:?}", quads.defects);
+    assert!(quads.defects.is_empty(), "{:?}", quads.defects);
     let q = check_quads(&solution.mesh, &quads, &CheckOptions::default());
-    assert_eq!((q.euler_characteristic, q.boundary_loops, q.components), (2, 0, 1), "{q:?}");
+    let (euler, loops) = (solution.mesh.euler_characteristic(), solution.mesh.boundary_loops().len());
+    assert_eq!((q.euler_characteristic, q.boundary_loops, q.components), (euler, loops, 1), "{q:?}");
     assert_eq!((q.non_manifold_edges, q.unreferenced_vertices), (0, 0), "{q:?}");
 }
 
