@@ -613,7 +613,7 @@ impl Quantizer {
                 break;
             }
             let fit = Fit::new(&self.elements, &stiff, weight);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass::default(), progress)?;
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass::default(), progress)?.expect("a plain pass");
             keep_better(&mut best, rounded, s);
         }
         // Still bad where separations stayed violated (or in a few places):
@@ -621,15 +621,16 @@ impl Quantizer {
         let held_pass = |b: &Rounded| b.collapsed + b.wound > 0 && (b.separations_violated > 0 || b.collapsed + b.wound <= STIFF_PASS_LIMIT);
         if best.as_ref().is_some_and(|(b, _)| held_pass(b)) {
             let fit = Fit::new(&self.elements, &stiff, 1.0);
-            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, widen: false }, progress)?;
+            let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, widen: false }, progress)?.expect("a held pass");
             // Where the held rows could not part every held pair (rows dropped
             // as dependent), the same with rows widened: another trajectory
             // of the rounding, kept only if it ends better.
             let widen = rounded.held_dropped > 0 && rounded.collapsed + rounded.wound > 0;
             keep_better(&mut best, rounded, s);
             if widen {
-                let rounded = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, widen: true }, progress)?;
-                keep_dominant(&mut best, rounded, s);
+                if let Some(rounded) = self.round_and_polish(&fit, &x0, &targets, s, &rules, Pass { hold: true, widen: true }, progress)? {
+                    keep_dominant(&mut best, rounded, s);
+                }
             }
         }
         // A quad count only asks for about so many quads: where the map
@@ -649,11 +650,10 @@ impl Quantizer {
             let rules = self.size_rules(&x0, s_retry);
             let fit = fit.get_or_insert_with(|| Fit::new(&self.elements, &stiff, 1.0));
             for pass in [held, best_pass].into_iter().take(if best_pass.widen { 2 } else { 1 }) {
-                let rounded = self.round_and_polish(fit, &x0, &targets, s_retry, &rules, pass, progress)?;
-                if pass.widen {
-                    keep_dominant(&mut best, rounded, s_retry);
-                } else {
-                    keep_better(&mut best, rounded, s_retry);
+                match self.round_and_polish(fit, &x0, &targets, s_retry, &rules, pass, progress)? {
+                    Some(rounded) if pass.widen => keep_dominant(&mut best, rounded, s_retry),
+                    Some(rounded) => keep_better(&mut best, rounded, s_retry),
+                    None => {}
                 }
             }
         }
@@ -764,7 +764,9 @@ impl Quantizer {
     /// [`Self::polish`], and where the map is still bad [`Self::uncollapse`]
     /// and polish again, keeping the better. With `pass.hold`, the relaxed
     /// map first and every batch after it hold the separations they leave
-    /// violated ([`HeldApart`]).
+    /// violated ([`HeldApart`]); with `pass.widen` too, held rows are
+    /// widened first ([`Self::widen_held`]), and the pass is not run
+    /// (`None`) where that widens nothing: it would repeat the held pass.
     #[allow(clippy::too_many_arguments)]
     fn round_and_polish(
         &self,
@@ -775,7 +777,7 @@ impl Quantizer {
         rules: &SizeRules,
         pass: Pass,
         progress: &mut dyn FnMut(usize, usize),
-    ) -> Result<Rounded, QuantizeError> {
+    ) -> Result<Option<Rounded>, QuantizeError> {
         let separations = &rules.separations;
         let mut values: Vec<Option<i64>> = vec![None; self.forms.len()];
         let mut order: Vec<usize> = Vec::new();
@@ -795,10 +797,15 @@ impl Quantizer {
                 x = solved.x.clone();
                 relaxed = Some(solved);
             }
+            if relaxed.is_none() && pass.widen {
+                return Ok(None);
+            }
             if let Some(mut relaxed) = relaxed {
                 held_dropped = held.violated(&relaxed.x, NEAR_INTEGER).len();
-                if pass.widen {
-                    self.widen_held(&mut relaxed, &mut held, x0, targets)?;
+                // A widened pass that widens nothing would repeat the held
+                // pass step for step.
+                if pass.widen && self.widen_held(&mut relaxed, &mut held, x0, targets)? == 0 {
+                    return Ok(None);
                 }
                 x = relaxed.x;
             }
@@ -901,7 +908,7 @@ impl Quantizer {
             }
         }
         let (collapsed, wound, distortion, separations_violated) = self.assess(&x, s, targets, separations);
-        Ok(Rounded {
+        Ok(Some(Rounded {
             x,
             values,
             batches,
@@ -920,7 +927,7 @@ impl Quantizer {
             pass,
             separations_violated,
             free_curve_ends: self.curve_ends.iter().filter(|end| end.free_at(s)).count(),
-        })
+        }))
     }
 
     /// Area-weighted mean of `|J_f - T_f|^2` over the faces (the fit's
