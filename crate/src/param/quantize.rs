@@ -1048,17 +1048,10 @@ impl Quantizer {
                     .form_rows
                     .iter()
                     .filter_map(|&(form, row)| {
-                        let gain = gap_gain[row];
                         let v = values[form]?;
-                        // A gain of one half (a translation across a
-                        // half-turn seam: `f_g(P) + f_f(P) = 2 p`) widens
-                        // the gap by a line in two steps.
-                        (gain.abs() > 0.25).then(|| {
-                            let magnitude = if gain.abs() > 0.75 { 1 } else { 2 };
-                            let step = if gain > 0.0 { magnitude } else { -magnitude };
-                            let cost = ((v + step) as f64 - self.forms[form].value(x0)).abs();
-                            (cost, form, row, step)
-                        })
+                        let step = widening_step(gap_gain[row])?;
+                        let cost = ((v + step) as f64 - self.forms[form].value(x0)).abs();
+                        Some((cost, form, row, step))
                     })
                     .collect();
                 candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -1394,12 +1387,10 @@ impl Quantizer {
                 .iter()
                 .filter(|&&(k, _)| held.list[k] != pair)
                 .filter_map(|&(k, row)| {
-                    let g = gain[row];
-                    (g > 0.25).then(|| {
-                        let step = if g > 0.75 { 1 } else { 2 };
-                        let sep = held.list[k];
-                        ((held.gaps[k] + step) as f64 - (x0[sep.hi] - x0[sep.lo]), k, row, step)
-                    })
+                    // Held gaps only grow.
+                    let step = widening_step(gain[row]).filter(|&step| step > 0)?;
+                    let sep = held.list[k];
+                    Some(((held.gaps[k] + step) as f64 - (x0[sep.hi] - x0[sep.lo]), k, row, step))
                 })
                 .collect();
             candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -1651,6 +1642,15 @@ impl RoundedSystem {
         }
         Ok(x[..q.n_unknowns].to_vec())
     }
+}
+
+/// The change of a row's value that widens a gap by a grid line, from the
+/// gap's `gain` per unit change of that row: one, or two where the gain is a
+/// half (a translation across a half-turn seam: `f_g(P) + f_f(P) = 2 p`), in
+/// the gain's direction; `None` where the row barely moves the gap.
+fn widening_step(gain: f64) -> Option<i64> {
+    let magnitude = if gain.abs() > 0.75 { 1 } else { 2 };
+    (gain.abs() > 0.25).then_some(if gain > 0.0 { magnitude } else { -magnitude })
 }
 
 /// Keeps the better of `best` and `candidate` (rounded at grid length
