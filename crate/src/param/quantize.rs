@@ -1303,8 +1303,10 @@ impl Quantizer {
             unknowns.dedup();
             unknowns.truncate(max_probes);
             let mut gain = vec![0.0f64; system.b.len()];
-            for &u in &unknowns {
-                for (g, d) in gain.iter_mut().zip(system.sensitivity(&[(u, 1)])?) {
+            let probes: Vec<[(usize, i64); 1]> = unknowns.iter().map(|&u| [(u, 1)]).collect();
+            let rows: Vec<&[(usize, i64)]> = probes.iter().map(|p| &p[..]).collect();
+            for column in system.sensitivities(&rows)? {
+                for (g, d) in gain.iter_mut().zip(column) {
                     *g = g.max(d.abs());
                 }
             }
@@ -1632,12 +1634,21 @@ impl RoundedSystem {
     /// per unit change of that row's value (the multipliers of `K⁻¹ [row; 0]`,
     /// `K` symmetric).
     fn sensitivity(&self, row: &[(usize, i64)]) -> Result<Vec<f64>, QuantizeError> {
-        let mut rhs = vec![0.0; self.n + self.b.len()];
-        for &(i, a) in row {
-            rhs[i] += a as f64;
+        Ok(self.sensitivities(&[row])?.pop().unwrap_or_default())
+    }
+
+    /// [`Self::sensitivity`] of each of `rows`, solved together (one pass
+    /// over the factor for all of them).
+    fn sensitivities(&self, rows: &[&[(usize, i64)]]) -> Result<Vec<Vec<f64>>, QuantizeError> {
+        let dim = self.n + self.b.len();
+        let mut rhs = vec![0.0; dim * rows.len()];
+        for (column, row) in rhs.chunks_mut(dim).zip(rows) {
+            for &(i, a) in row.iter() {
+                column[i] += a as f64;
+            }
         }
-        let z = self.solver.solve_many_to(&rhs, 1, SOLVE_TOLERANCE)?.0;
-        Ok(z[self.n..].to_vec())
+        let z = self.solver.solve_many_to(&rhs, rows.len(), SOLVE_TOLERANCE)?.0;
+        Ok(z.chunks(dim).map(|column| column[self.n..].to_vec()).collect())
     }
 
     /// `q <- Z (Zᵀ A Z)⁻¹ Zᵀ q` (the untangler's preconditioner): the solve
