@@ -103,6 +103,7 @@ use forms::{
 };
 use parts::Part;
 use serde::Serialize;
+use std::cell::OnceCell;
 use std::f64::consts::PI;
 use std::fmt;
 
@@ -463,6 +464,14 @@ impl Quantizer {
         Ok(quantizer)
     }
 
+    /// The start of a rounding at grid length `s` ([`GridStart`]).
+    fn grid_start(&self, s: f64) -> GridStart {
+        let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
+        let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
+        let rules = self.size_rules(&x0, s);
+        GridStart { x0, targets, s, rules }
+    }
+
     /// Faces within [`STIFF_RADIUS`] grid units (in the seamless map `x0`,
     /// grid units) of a singular point, reached through faces of its chart:
     /// a rounded point drags a fit of uniform weight along as a spike (a
@@ -604,60 +613,49 @@ impl Quantizer {
     /// separations where the best map so far is the held pass's. Returns
     /// the map kept and its grid length.
     fn round(&self, s: f64, retry: bool, options: &QuantizeOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<(Rounded, f64), QuantizeError> {
-        // The seamless map in units of the grid length `s`, and its Jacobians
-        // (the fit's targets).
-        let start = |s: f64| {
-            let x0: Vec<f64> = self.seamless.iter().map(|v| v / s).collect();
-            let targets: Vec<[[f64; 2]; 2]> = self.elements.iter().map(|el| el.jacobian(&x0)).collect();
-            (x0, targets)
-        };
-        let (x0, targets) = start(s);
-        let stiff = self.stiff_faces(&x0);
-        let rules = self.size_rules(&x0, s);
-        let plain = self.round_and_polish(&Fit::new(&self.elements, &stiff, 1.0), &x0, &targets, s, &rules, Pass::default(), progress)?.expect("a plain pass");
+        let grid = self.grid_start(s);
+        let stiff = self.stiff_faces(&grid.x0);
+        let plain_fit = Fit::new(&self.elements, &stiff, 1.0);
+        let plain = self.round_and_polish(&plain_fit, &grid, Pass::default(), progress)?.expect("a plain pass");
         let bad = |b: &Rounded| b.collapsed + b.wound > 0;
         let is_bad = |best: &Option<(Rounded, f64)>| best.as_ref().is_some_and(|(b, _)| bad(b));
         // Stiffer fits mend a few bad places next to cones; the held
         // separations mend collapses between parallel lines, and go first
         // where the plain fit leaves separations violated.
-        let stiffer = bad(&plain) && plain.collapsed + plain.wound <= STIFF_PASS_LIMIT && stiff.contains(&true);
+        let few = bad(&plain) && plain.collapsed + plain.wound <= STIFF_PASS_LIMIT;
+        let stiffer = few && stiff.contains(&true);
         let held_first = bad(&plain) && plain.separations_violated > 0;
-        let held_later = bad(&plain) && plain.collapsed + plain.wound <= STIFF_PASS_LIMIT;
         let mut best = None;
         keep_better(&mut best, plain, s);
         if held_first {
-            self.held_passes(&stiff, &x0, &targets, s, &rules, &mut best, progress)?;
+            self.held_passes(&plain_fit, &grid, &mut best, progress)?;
         }
         for &weight in STIFF_WEIGHTS.iter().skip(1).filter(|_| stiffer) {
             if !is_bad(&best) {
                 break;
             }
-            let rounded = self.round_and_polish(&Fit::new(&self.elements, &stiff, weight), &x0, &targets, s, &rules, Pass::default(), progress)?.expect("a stiff pass");
+            let rounded = self.round_and_polish(&Fit::new(&self.elements, &stiff, weight), &grid, Pass::default(), progress)?.expect("a stiff pass");
             keep_better(&mut best, rounded, s);
         }
-        if !held_first && held_later && is_bad(&best) {
-            self.held_passes(&stiff, &x0, &targets, s, &rules, &mut best, progress)?;
+        if !held_first && few && is_bad(&best) {
+            self.held_passes(&plain_fit, &grid, &mut best, progress)?;
         }
         // A quad count only asks for about so many quads: where the map
         // still folds, nearby grid lengths round differently and often
         // cleanly (holding the separations where a held pass did best; where
         // the widened one did, both held and widened: each length rounds its
         // own way).
-        let mut fit = None;
         for factor in RETRY_GRID_FACTORS.into_iter().filter(|_| retry) {
             let Some((b, _)) = best.as_ref() else { break };
             if b.collapsed == 0 && (b.wound == 0 || !options.retry_wound) {
                 break;
             }
             let (held, best_pass) = (Pass { hold: b.separations_held > 0, widen: false }, b.pass);
-            let s_retry = s * factor;
-            let (x0, targets) = start(s_retry);
-            let rules = self.size_rules(&x0, s_retry);
-            let fit = fit.get_or_insert_with(|| Fit::new(&self.elements, &stiff, 1.0));
+            let retried = self.grid_start(s * factor);
             for pass in [held, best_pass].into_iter().take(if best_pass.widen { 2 } else { 1 }) {
-                match self.round_and_polish(fit, &x0, &targets, s_retry, &rules, pass, progress)? {
-                    Some(rounded) if pass.widen => keep_dominant(&mut best, rounded, s_retry),
-                    Some(rounded) => keep_better(&mut best, rounded, s_retry),
+                match self.round_and_polish(&plain_fit, &retried, pass, progress)? {
+                    Some(rounded) if pass.widen => keep_dominant(&mut best, rounded, retried.s),
+                    Some(rounded) => keep_better(&mut best, rounded, retried.s),
                     None => {}
                 }
             }
@@ -665,28 +663,17 @@ impl Quantizer {
         Ok(best.expect("at least one pass"))
     }
 
-    /// The held pass (the plain fit, the separations held as rows), and
-    /// where its held rows could not part every held pair (rows dropped as
-    /// dependent) and its map is bad, the widened one: another trajectory of
-    /// the rounding, kept only if it dominates ([`keep_dominant`]).
-    #[allow(clippy::too_many_arguments)]
-    fn held_passes(
-        &self,
-        stiff: &[bool],
-        x0: &[f64],
-        targets: &[[[f64; 2]; 2]],
-        s: f64,
-        rules: &SizeRules,
-        best: &mut Option<(Rounded, f64)>,
-        progress: &mut dyn FnMut(usize, usize),
-    ) -> Result<(), QuantizeError> {
-        let fit = Fit::new(&self.elements, stiff, 1.0);
-        let rounded = self.round_and_polish(&fit, x0, targets, s, rules, Pass { hold: true, widen: false }, progress)?.expect("a held pass");
+    /// The held pass (the plain fit `fit`, the separations held as rows),
+    /// and where its held rows could not part every held pair (rows dropped
+    /// as dependent) and its map is bad, the widened one: another trajectory
+    /// of the rounding, kept only if it dominates ([`keep_dominant`]).
+    fn held_passes(&self, fit: &Fit, grid: &GridStart, best: &mut Option<(Rounded, f64)>, progress: &mut dyn FnMut(usize, usize)) -> Result<(), QuantizeError> {
+        let rounded = self.round_and_polish(fit, grid, Pass { hold: true, widen: false }, progress)?.expect("a held pass");
         let widen = rounded.held_dropped > 0 && rounded.collapsed + rounded.wound > 0;
-        keep_better(best, rounded, s);
+        keep_better(best, rounded, grid.s);
         if widen {
-            if let Some(rounded) = self.round_and_polish(&fit, x0, targets, s, rules, Pass { hold: true, widen: true }, progress)? {
-                keep_dominant(best, rounded, s);
+            if let Some(rounded) = self.round_and_polish(fit, grid, Pass { hold: true, widen: true }, progress)? {
+                keep_dominant(best, rounded, grid.s);
             }
         }
         Ok(())
@@ -799,17 +786,9 @@ impl Quantizer {
     /// violated ([`HeldApart`]); with `pass.widen` too, held rows are
     /// widened first ([`Self::widen_held`]), and the pass is not run
     /// (`None`) where that widens nothing: it would repeat the held pass.
-    #[allow(clippy::too_many_arguments)]
-    fn round_and_polish(
-        &self,
-        fit: &Fit,
-        x0: &[f64],
-        targets: &[[[f64; 2]; 2]],
-        s: f64,
-        rules: &SizeRules,
-        pass: Pass,
-        progress: &mut dyn FnMut(usize, usize),
-    ) -> Result<Option<Rounded>, QuantizeError> {
+    fn round_and_polish(&self, fit: &Fit, grid: &GridStart, pass: Pass, progress: &mut dyn FnMut(usize, usize)) -> Result<Option<Rounded>, QuantizeError> {
+        let GridStart { x0, targets, s, rules } = grid;
+        let s = *s;
         let separations = &rules.separations;
         let mut values: Vec<Option<i64>> = vec![None; self.forms.len()];
         let mut order: Vec<usize> = Vec::new();
@@ -1213,17 +1192,7 @@ impl Quantizer {
             // Untangle in model units (the barrier's area term wants det J ~ 1).
             let projector =
                 NullSpaceProjector::new(&system.c, self.n_unknowns, system.b.len()).ok();
-            // The untangler's energy weighs every face alike, and so must its
-            // preconditioner: with a stiffer fit's KKT its steps near singular
-            // points came out 10-100 times too short (fandisk >60 at 1 500
-            // quads: 17 s -> 12 s, the same map).
-            let uniform = if system.weights.iter().all(|&w| w == 1.0) {
-                None
-            } else {
-                let stiffness = stiffness_triplets(&self.elements, &vec![1.0; self.elements.len()]);
-                Some(factored(&Kkt::assemble(&stiffness, self.n_unknowns, &system.c, system.b.len())?)?)
-            };
-            let solver = uniform.as_ref().unwrap_or(&system.solver);
+            let solver = system.untangle_solver(self)?;
             let precondition = |q: &mut [f64]| system.precondition(solver, q, projector.as_ref());
             let mut xm: Vec<f64> = x.iter().map(|v| v * s).collect();
             let stats = untangle(
@@ -1304,8 +1273,7 @@ impl Quantizer {
             unknowns.truncate(max_probes);
             let mut gain = vec![0.0f64; system.b.len()];
             let probes: Vec<[(usize, i64); 1]> = unknowns.iter().map(|&u| [(u, 1)]).collect();
-            let rows: Vec<&[(usize, i64)]> = probes.iter().map(|p| &p[..]).collect();
-            for column in system.sensitivities(&rows)? {
+            for column in system.sensitivities(&probes)? {
                 for (g, d) in gain.iter_mut().zip(column) {
                     *g = g.max(d.abs());
                 }
@@ -1526,6 +1494,7 @@ impl Quantizer {
         let mut system = RoundedSystem {
             weights: fit.weights.clone(),
             solver,
+            uniform: OnceCell::new(),
             c,
             b,
             form_rows,
@@ -1614,11 +1583,23 @@ struct SeparationMove {
     violated: Vec<Separation>,
 }
 
+/// What a rounding at one grid length starts from: the seamless map in
+/// units of the grid length `s` (`x0`), its Jacobians (the fit's targets)
+/// and the rules of that length ([`SizeRules`]).
+struct GridStart {
+    x0: Vec<f64>,
+    targets: Vec<[[f64; 2]; 2]>,
+    s: f64,
+    rules: SizeRules,
+}
+
 /// A factored KKT of [`Quantizer::solve`] and its constraint values.
 struct RoundedSystem {
     /// Per face: the weight of its Jacobian fit ([`Fit`]).
     weights: Vec<f64>,
     solver: LdltSolver,
+    /// [`Self::untangle_solver`] of a stiffer fit, once factored.
+    uniform: OnceCell<LdltSolver>,
     c: Vec<Triplet>,
     b: Vec<f64>,
     /// The rows of `c` that are rounded forms: (form, row).
@@ -1630,6 +1611,25 @@ struct RoundedSystem {
 }
 
 impl RoundedSystem {
+    /// The factored KKT the untangler is preconditioned with. Its energy
+    /// weighs every face alike, and so must its preconditioner: with a
+    /// stiffer fit's KKT its steps near singular points came out 10-100
+    /// times too short (fandisk >60 at 1 500 quads: 17 s -> 12 s, the same
+    /// map). This system's own where its fit is uniform; else the same rows
+    /// with uniform weights, factored on first use and kept (it depends on
+    /// the rows `c`, which [`Quantizer::uncollapse`] leaves, not on `b`).
+    fn untangle_solver(&self, q: &Quantizer) -> Result<&LdltSolver, QuantizeError> {
+        if self.weights.iter().all(|&w| w == 1.0) {
+            return Ok(&self.solver);
+        }
+        if self.uniform.get().is_none() {
+            let stiffness = stiffness_triplets(&q.elements, &vec![1.0; q.elements.len()]);
+            let solver = factored(&Kkt::assemble(&stiffness, q.n_unknowns, &self.c, self.b.len())?)?;
+            let _ = self.uniform.set(solver);
+        }
+        Ok(self.uniform.get().expect("set above"))
+    }
+
     /// Per row of `c`: the change of the linear form `row` of the solution
     /// per unit change of that row's value (the multipliers of `K⁻¹ [row; 0]`,
     /// `K` symmetric).
@@ -1639,11 +1639,11 @@ impl RoundedSystem {
 
     /// [`Self::sensitivity`] of each of `rows`, solved together (one pass
     /// over the factor for all of them).
-    fn sensitivities(&self, rows: &[&[(usize, i64)]]) -> Result<Vec<Vec<f64>>, QuantizeError> {
+    fn sensitivities<R: AsRef<[(usize, i64)]>>(&self, rows: &[R]) -> Result<Vec<Vec<f64>>, QuantizeError> {
         let dim = self.n + self.b.len();
         let mut rhs = vec![0.0; dim * rows.len()];
         for (column, row) in rhs.chunks_mut(dim).zip(rows) {
-            for &(i, a) in row.iter() {
+            for &(i, a) in row.as_ref() {
                 column[i] += a as f64;
             }
         }
