@@ -48,6 +48,11 @@ pub struct FactorOptions {
     /// if larger) is reported as [`LinalgError::NotConverged`]; between
     /// `tolerance` and this it is returned (check [`SolveInfo::relative_residual`]).
     pub accept_residual: f64,
+    /// A column whose refinement stagnates with its relative residual already
+    /// below this is returned as it is instead of being finished by GMRES
+    /// (`0`: always finished). For callers whose `tolerance` may lie below
+    /// what their systems reach in floating point.
+    pub stall_accept: f64,
 }
 
 impl Default for FactorOptions {
@@ -58,6 +63,7 @@ impl Default for FactorOptions {
             tolerance: 1e-12,
             max_refinement_steps: 5,
             accept_residual: 1e-8,
+            stall_accept: 0.0,
         }
     }
 }
@@ -319,7 +325,9 @@ impl Core {
                     continue;
                 }
                 if (step > 0 && rel > STALL_RATIO * previous) || step == opts.max_refinement_steps {
-                    stalled.push(j);
+                    if rel >= opts.stall_accept {
+                        stalled.push(j);
+                    }
                 } else if step < opts.max_refinement_steps {
                     active.push(j);
                 }

@@ -344,3 +344,26 @@ fn null_space_projection_is_orthogonal() {
     // Rank-deficient rows are refused.
     assert!(NullSpaceProjector::new(&[(0, 0, 1.0), (1, 0, 2.0)], 2, 2).is_err());
 }
+
+/// A solve whose refinement stagnates below `stall_accept` is returned as it
+/// is; with `stall_accept = 0` the same solve is finished by GMRES. The
+/// tolerance 0 is unreachable, so refinement always stagnates.
+#[test]
+fn stagnating_solves_below_stall_accept_skip_gmres() {
+    let (nx, ny) = (9, 8);
+    let n = nx * ny;
+    let (p, v) = SymmetricPattern::with_values(n, &grid_laplacian(nx, ny, 0.5)).unwrap();
+    let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+    let solve = |stall_accept: f64| {
+        let opts = FactorOptions { tolerance: 0.0, stall_accept, ..FactorOptions::default() };
+        let mut s = LdltSolver::with_options(&p, &vec![1; n], opts).unwrap();
+        s.factorize(&v).unwrap();
+        let (x, info) = s.solve_many_to(&b, 1, 0.0).unwrap();
+        assert!(rel_residual(&p, &v, &x, &b) < 1e-13, "{info:?}");
+        info[0]
+    };
+    let accepted = solve(1e-10);
+    assert!(accepted.refinement_steps <= 2, "{accepted:?}");
+    let finished = solve(0.0);
+    assert!(finished.refinement_steps > 10, "{finished:?}");
+}
