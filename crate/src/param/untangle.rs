@@ -257,12 +257,12 @@ pub(super) fn untangle(elements: &[Element], precondition: &dyn Fn(&mut [f64]), 
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// A `n × n`-vertex grid on the unit square as elements of the identity
     /// map (u unknowns `0..n²`, v unknowns `n²..2n²`), and its boundary flags.
-    fn grid(n: usize) -> (Vec<Element>, Vec<[f64; 2]>, Vec<bool>) {
+    pub(in crate::param) fn grid(n: usize) -> (Vec<Element>, Vec<[f64; 2]>, Vec<bool>) {
         let id = |i: usize, j: usize| i * n + j;
         let p: Vec<[f64; 2]> = (0..n * n).map(|k| [(k / n) as f64 / (n - 1) as f64, (k % n) as f64 / (n - 1) as f64]).collect();
         let boundary = (0..n * n).map(|k| k / n == 0 || k / n == n - 1 || k % n == 0 || k % n == n - 1).collect();
