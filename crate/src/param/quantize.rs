@@ -1209,15 +1209,16 @@ impl Quantizer {
             // Untangle in model units (the barrier's area term wants det J ~ 1):
             // around the folds on a large mesh, else the whole map.
             let mut xm: Vec<f64> = x.iter().map(|v| v * s).collect();
-            let mut stats = self.untangle_locally(&mut xm, system, s)?;
-            if stats.is_none() {
-                let projector =
-                    NullSpaceProjector::new(&system.c, self.n_unknowns, system.b.len()).ok();
-                let solver = system.untangle_solver(self)?;
-                let precondition = |q: &mut [f64]| system.precondition(solver, q, projector.as_ref());
-                stats = Some(untangle(&self.elements, &precondition, &mut xm, &self.polish_untangle()));
-            }
-            let stats = stats.expect("untangled");
+            let stats = match self.untangle_locally(&mut xm, system, s)? {
+                Some(stats) => stats,
+                None => {
+                    let projector =
+                        NullSpaceProjector::new(&system.c, self.n_unknowns, system.b.len()).ok();
+                    let solver = system.untangle_solver(self)?;
+                    let precondition = |q: &mut [f64]| system.precondition(solver, q, projector.as_ref());
+                    untangle(&self.elements, &precondition, &mut xm, &self.polish_untangle())
+                }
+            };
             let candidate = system.onto_constraints(xm.iter().map(|v| v / s).collect())?;
             let f = self.badness(&candidate, s);
             if f < bad {
@@ -1360,7 +1361,11 @@ impl Quantizer {
                 break;
             }
             let rings = (cells * s / edge).ceil().clamp(1.0, MAX_PATCH_RINGS as f64) as usize;
-            let Some(patch) = local::Patch::around(&self.faces, &self.elements, &system.c, system.b.len(), self.n_unknowns, &seeds, rings, MAX_PATCH_SHARE)? else {
+            let in_patch = local::faces_around(&self.faces, &seeds, rings);
+            if in_patch.iter().filter(|&&inside| inside).count() as f64 > MAX_PATCH_SHARE * self.faces.len() as f64 {
+                return Ok(None);
+            }
+            let Some(patch) = local::Patch::new(&self.elements, &in_patch, &system.c, system.b.len(), self.n_unknowns)? else {
                 return Ok(None);
             };
             let stats = patch.untangle(xm, &self.polish_untangle());

@@ -33,49 +33,42 @@ pub(super) fn inverted_faces(elements: &[Element], x: &[f64]) -> Vec<usize> {
     (0..elements.len()).filter(|&f| !(signed_uv_area(elements[f].unknowns_uv(x)) > 0.0)).collect()
 }
 
-impl Patch {
-    /// The faces within `rings` vertex rings of `seeds` (faces of `faces`,
-    /// corner `k` of face `f` is column `k` of `elements[f]`); their
-    /// unknowns are free unless a face outside uses them too. `c` (rows `<
-    /// m`) are the system's rows on all `n` unknowns. `None` when the patch
-    /// has no free unknown or more than `max_share` of the faces.
-    pub(super) fn around(
-        faces: &[[u32; 3]],
-        elements: &[Element],
-        c: &[Triplet],
-        m: usize,
-        n: usize,
-        seeds: &[usize],
-        rings: usize,
-        max_share: f64,
-    ) -> Result<Option<Patch>, LinalgError> {
-        let n_vertices = faces.iter().flatten().map(|&v| v as usize + 1).max().unwrap_or(0);
-        let mut vertex_faces: Vec<Vec<usize>> = vec![Vec::new(); n_vertices];
-        for (f, face) in faces.iter().enumerate() {
-            for &v in face {
-                vertex_faces[v as usize].push(f);
-            }
+/// Per face of `faces`: whether it lies within `rings` vertex rings of the
+/// faces `seeds`.
+pub(super) fn faces_around(faces: &[[u32; 3]], seeds: &[usize], rings: usize) -> Vec<bool> {
+    let n_vertices = faces.iter().flatten().map(|&v| v as usize + 1).max().unwrap_or(0);
+    let mut vertex_faces: Vec<Vec<usize>> = vec![Vec::new(); n_vertices];
+    for (f, face) in faces.iter().enumerate() {
+        for &v in face {
+            vertex_faces[v as usize].push(f);
         }
-        let mut in_patch = vec![false; faces.len()];
-        let mut front: Vec<usize> = seeds.to_vec();
-        front.iter().for_each(|&f| in_patch[f] = true);
-        for _ in 0..rings {
-            let mut next = Vec::new();
-            for &f in &front {
-                for &v in &faces[f] {
-                    for &g in &vertex_faces[v as usize] {
-                        if !in_patch[g] {
-                            in_patch[g] = true;
-                            next.push(g);
-                        }
+    }
+    let mut in_patch = vec![false; faces.len()];
+    let mut front: Vec<usize> = seeds.to_vec();
+    front.iter().for_each(|&f| in_patch[f] = true);
+    for _ in 0..rings {
+        let mut next = Vec::new();
+        for &f in &front {
+            for &v in &faces[f] {
+                for &g in &vertex_faces[v as usize] {
+                    if !in_patch[g] {
+                        in_patch[g] = true;
+                        next.push(g);
                     }
                 }
             }
-            front = next;
         }
-        if in_patch.iter().filter(|&&inside| inside).count() as f64 > max_share * faces.len() as f64 {
-            return Ok(None);
-        }
+        front = next;
+    }
+    in_patch
+}
+
+impl Patch {
+    /// The patch of the faces `in_patch` (face `f` is `elements[f]`): their
+    /// unknowns are free unless a face outside uses them too. `c` (rows `<
+    /// m`) are the system's rows on all `n` unknowns. `None` when the patch
+    /// has no free unknown.
+    pub(super) fn new(elements: &[Element], in_patch: &[bool], c: &[Triplet], m: usize, n: usize) -> Result<Option<Patch>, LinalgError> {
         // Unknowns of faces outside are held; the patch's others are free.
         let mut held = vec![false; n];
         let mut used = vec![false; n];
@@ -104,7 +97,7 @@ impl Patch {
         }
         let patch_elements: Vec<Element> = elements
             .iter()
-            .zip(&in_patch)
+            .zip(in_patch)
             .filter(|(_, &inside)| inside)
             .map(|(el, _)| Element { x: el.x.map(|row| row.map(|u| local[u])), ..*el })
             .collect();
@@ -190,7 +183,7 @@ mod tests {
         }
         let seeds = inverted_faces(&elements, &x);
         assert!(seeds.len() >= 2, "the start must be folded");
-        let patch = Patch::around(&faces, &elements, &c, rows.len(), 2 * nv, &seeds, 2, 1.0).unwrap().expect("free unknowns");
+        let patch = Patch::new(&elements, &faces_around(&faces, &seeds, 2), &c, rows.len(), 2 * nv).unwrap().expect("free unknowns");
         let before = x.clone();
         let stats = patch.untangle(&mut x, &UntangleOptions::default());
         assert_eq!(stats.inverted, 0, "{stats:?}");
