@@ -1215,7 +1215,7 @@ impl Quantizer {
                     let projector =
                         NullSpaceProjector::new(&system.c, self.n_unknowns, system.b.len()).ok();
                     let solver = system.untangle_solver(self)?;
-                    let precondition = |q: &mut [f64]| system.precondition(solver, q, projector.as_ref());
+                    let precondition = |q: &mut [f64]| precondition(solver, system.b.len(), q, projector.as_ref());
                     untangle(&self.elements, &precondition, &mut xm, &self.polish_untangle())
                 }
             };
@@ -1710,21 +1710,6 @@ impl RoundedSystem {
         Ok(z.chunks(dim).map(|column| column[self.n..].to_vec()).collect())
     }
 
-    /// `q <- Z (Zᵀ A Z)⁻¹ Zᵀ q` (the untangler's preconditioner): the solve
-    /// for `(q, 0)` with `solver`, a factored KKT of this system's rows `C`
-    /// and some SPD `A`, put back onto `C q = 0` by `projector`; 0 when it fails.
-    fn precondition(&self, solver: &LdltSolver, q: &mut [f64], projector: Option<&NullSpaceProjector>) {
-        let mut rhs = q.to_vec();
-        rhs.resize(self.n + self.b.len(), 0.0);
-        match solver.solve_many_to(&rhs, 1, PRECONDITION_TOLERANCE) {
-            Ok((x, _)) => q.copy_from_slice(&x[..self.n]),
-            Err(_) => q.iter_mut().for_each(|v| *v = 0.0),
-        }
-        if let Some(projector) = projector {
-            projector.project(q, 1e-14, 3);
-        }
-    }
-
     /// `x` moved back onto the rows `C x = b` by the smallest change in the
     /// stiffness norm (one solve for `(0, b - C x)`).
     fn onto_constraints(&self, mut x: Vec<f64>) -> Result<Vec<f64>, QuantizeError> {
@@ -1755,6 +1740,23 @@ impl RoundedSystem {
             }));
         }
         Ok(x[..q.n_unknowns].to_vec())
+    }
+}
+
+/// `q <- Z (Zᵀ A Z)⁻¹ Zᵀ q` (the untangler's preconditioner): the solve
+/// for `(q, 0)` with `solver`, a factored KKT of `n_rows` rows `C` (on the
+/// `q.len()` unknowns) and some SPD `A`, put back onto `C q = 0` by
+/// `projector`; 0 when it fails.
+fn precondition(solver: &LdltSolver, n_rows: usize, q: &mut [f64], projector: Option<&NullSpaceProjector>) {
+    let n = q.len();
+    let mut rhs = q.to_vec();
+    rhs.resize(n + n_rows, 0.0);
+    match solver.solve_many_to(&rhs, 1, PRECONDITION_TOLERANCE) {
+        Ok((x, _)) => q.copy_from_slice(&x[..n]),
+        Err(_) => q.iter_mut().for_each(|v| *v = 0.0),
+    }
+    if let Some(projector) = projector {
+        projector.project(q, 1e-14, 3);
     }
 }
 

@@ -129,17 +129,11 @@ impl Patch {
     /// unknowns, the others held; `x` is changed only there.
     pub(super) fn untangle(&self, x: &mut [f64], options: &UntangleOptions) -> UntangleStats {
         let mut xl: Vec<f64> = self.global.iter().map(|&u| x[u]).collect();
+        // Held unknowns do not move.
         let precondition = |q: &mut [f64]| {
-            let mut rhs = q[..self.n_free].to_vec();
-            rhs.resize(self.n_free + self.n_rows, 0.0);
-            match self.solver.solve_many_to(&rhs, 1, super::PRECONDITION_TOLERANCE) {
-                Ok((z, _)) => q[..self.n_free].copy_from_slice(&z[..self.n_free]),
-                Err(_) => q[..self.n_free].iter_mut().for_each(|v| *v = 0.0),
-            }
-            if let Some(projector) = &self.projector {
-                projector.project(&mut q[..self.n_free], 1e-14, 3);
-            }
-            q[self.n_free..].iter_mut().for_each(|v| *v = 0.0);
+            let (free, held) = q.split_at_mut(self.n_free);
+            super::precondition(&self.solver, self.n_rows, free, self.projector.as_ref());
+            held.iter_mut().for_each(|v| *v = 0.0);
         };
         let stats = untangle(&self.elements, &precondition, &mut xl, options);
         for (&u, &v) in self.global[..self.n_free].iter().zip(&xl) {
