@@ -77,14 +77,32 @@ impl RefineOptions {
     /// of `grid`, edges split down to [`QUAD_MAX_EDGE`] of its bounding-box
     /// diagonal or [`QUAD_MAX_EDGE_QUADS`] quads, whichever is shorter.
     pub fn for_quads(mesh: &TriMesh, grid: GridSize) -> RefineOptions {
-        let quad = match grid {
-            GridSize::Length(s) => s,
-            GridSize::Quads(n) => (mesh.face_areas().iter().sum::<f64>() / n.max(1) as f64).sqrt(),
-        };
+        let quad = quad_length(mesh, grid);
         let (by_diagonal, by_quads) = (QUAD_MAX_EDGE * mesh.bounding_diagonal(), QUAD_MAX_EDGE_QUADS * quad);
         // (A grid size that is not a positive length is the quantization's error to report.)
         let length = if by_quads > 0.0 && by_quads.is_finite() { by_diagonal.min(by_quads) } else { by_diagonal };
         RefineOptions { max_edge_length: Some(length), ..RefineOptions::default() }
+    }
+}
+
+/// The edge length of a quad of `grid` on `mesh`: the length given, or
+/// `sqrt(area / quads)` (the surface's area: about the map's).
+pub fn quad_length(mesh: &TriMesh, grid: GridSize) -> f64 {
+    match grid {
+        GridSize::Length(s) => s,
+        GridSize::Quads(n) => (mesh.face_areas().iter().sum::<f64>() / n.max(1) as f64).sqrt(),
+    }
+}
+
+impl SolveOptions {
+    /// These settings for the map behind an integer-grid map of `grid` on
+    /// `mesh`: opposite cones closer than a grid cell's diagonal cancel
+    /// ([`cones::ConeOptions::min_pair_distance`]). Where they were kept,
+    /// the rounding put each such pair on one grid point or folded the
+    /// cells between them.
+    pub fn for_quads(self, mesh: &TriMesh, grid: GridSize) -> SolveOptions {
+        let min_pair_distance = cones::GRID_PAIR_CELLS * quad_length(mesh, grid);
+        SolveOptions { cones: ConeOptions { min_pair_distance, ..self.cones }, ..self }
     }
 }
 

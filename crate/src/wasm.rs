@@ -75,17 +75,30 @@ pub struct MeshSession {
 }
 
 /// The map quads are traced on and its quantizer: changing the quad count
-/// re-runs only quantization and extraction.
+/// re-runs only quantization and extraction, unless the new grid cancels
+/// other cone pairs ([`Paired`]).
 struct GridStage {
     /// The last solve's map; for a mesh whose edges are longer than a quad
     /// mesh wants ([`pipeline::long_edges_refine`]), replaced on the first quads
     /// request by the map solved on its refinement.
     solution: Solution<'static>,
     quantizer: Option<Quantizer>,
+    /// The map solved again for the last quad count whose grid cancels
+    /// opposite cones of `solution` ([`SolveOptions::for_quads`]).
+    paired: Option<Paired>,
     /// The solve's features and settings as solved (with the low-poly
     /// fallback's maximum edge length, if it took one), to solve again on the refinement.
     features: FeatureSet,
     options: SolveOptions,
+}
+
+/// The map of [`GridStage::solution`] solved again with the cone pairs
+/// `pairs` (cut vertices, [`cones::ConePlacement::close_pairs`]) cancelled,
+/// kept while the quad count asked for cancels the same pairs.
+struct Paired {
+    pairs: Vec<(u32, u32)>,
+    solution: Solution<'static>,
+    quantizer: Quantizer,
 }
 
 /// A solve run in steps: its features and settings, its cone stage and the
@@ -306,7 +319,7 @@ impl MeshSession {
         let result = self.solution_object(mesh, &features, &sol)?;
         // As solved: a low-poly fallback's edge length is not asked again.
         let options = SolveOptions { refine: sol.refine_options, ..options };
-        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None, features, options });
+        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None, paired: None, features, options });
         Ok(result)
     }
 
@@ -315,7 +328,10 @@ impl MeshSession {
     /// quantization and extraction, except on the first call for a mesh
     /// with edges longer than a quad mesh wants: the map is then solved
     /// again on its refinement (`pipeline::long_edges_refine`; where that solve
-    /// fails, the last solve's map is used). Throws when nothing was solved
+    /// fails, the last solve's map is used), and where the grid cancels
+    /// opposite cones closer than a cell's diagonal that the last such call
+    /// did not ([`SolveOptions::for_quads`], [`Paired`]; where that solve
+    /// fails, the map without). Throws when nothing was solved
     /// yet, or with the quantization error (a free boundary, say).
     pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
         self.valid_mesh()?;
@@ -325,7 +341,7 @@ impl MeshSession {
         if let Some(refine) = pipeline::long_edges_refine(input, &grid.options.refine, Some(GridSize::Quads(quads as usize))) {
             let options = SolveOptions { refine, ..grid.options };
             match pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)) {
-                Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, features: grid.features.clone(), options },
+                Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, paired: None, features: grid.features.clone(), options },
                 // Quads on the map the page shows rather than none; not asked again.
                 Err(_) => grid.options = options,
             }
@@ -333,10 +349,20 @@ impl MeshSession {
         if grid.quantizer.is_none() {
             grid.quantizer = Some(grid.solution.quantizer().map_err(|e| JsError::new(&e.to_string()))?);
         }
+        let size = GridSize::Quads(quads as usize);
+        let pairs = grid.solution.placement.close_pairs(cones::GRID_PAIR_CELLS * pipeline::quad_length(input, size));
+        if !pairs.is_empty() && grid.paired.as_ref().is_none_or(|p| p.pairs != pairs) {
+            let options = grid.options.for_quads(input, size);
+            let solved = pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress));
+            // Where that fails, quads on the map without.
+            grid.paired = solved.ok().and_then(|sol| Some(Paired { quantizer: sol.quantizer().ok()?, pairs: pairs.clone(), solution: sol.into_owned() }));
+        }
         let input = self.valid_mesh()?;
         let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
-        let sol = &grid.solution;
-        let quantizer = grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?;
+        let (sol, quantizer, cancelled_pairs) = match &grid.paired {
+            Some(p) if !pairs.is_empty() && p.pairs == pairs => (&p.solution, &p.quantizer, pairs.len()),
+            _ => (&grid.solution, grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0),
+        };
         let map = quantizer
             .quantize(&sol.mesh, GridSize::Quads(quads as usize), &mut |done, total| notify(progress, "quantization", done, total, None))
             .map_err(|e| JsError::new(&e.to_string()))?;
@@ -361,6 +387,8 @@ impl MeshSession {
             edges: Uint32Array::from(&edges[..]),
             singular: Uint32Array::from(&singular[..]),
             defects: quad_mesh.defects.len(),
+            cones: sol.placement.cones.len(),
+            cancelled_pairs,
             solved_faces: sol.mesh.n_faces(),
             inserted_vertices: sol.splits,
             refinement: &sol.refinement,
@@ -600,6 +628,10 @@ struct QuadsResult<'a> {
     singular: Uint32Array,
     /// Places the extractor had to repair.
     defects: usize,
+    /// Cones of the map quantized, and the pairs of opposite cones of the
+    /// solve's map cancelled for this grid (closer than a cell's diagonal).
+    cones: usize,
+    cancelled_pairs: usize,
     /// The mesh the map was solved on: its faces, the vertices inserted into
     /// the input, and why ([`pipeline::long_edges_refine`] may have refined it).
     solved_faces: usize,

@@ -107,6 +107,24 @@ test('quads of a low-poly mesh are traced on a map solved again on its refinemen
   assert.equal(r2.solved_faces, r.solved_faces);
 });
 
+test('quads cancel the opposite cones a coarse grid cannot keep apart, solving again only when those pairs change', () => {
+  const session = open(sharedMesh('cow'));
+  const solved = session.solve(new Uint32Array(), undefined, false, () => {});
+  const stages = new Set();
+  const r = session.quads(1000, (stage) => stages.add(stage));
+  assert.ok(r.cancelled_pairs > 0, 'the cow has opposite cones closer than a quad diagonal at 1 000 quads');
+  assert.ok(stages.has('rounding') && stages.has('quantization'), [...stages].join(', '));
+  assert.ok(r.cones < solved.cones.length && r.cones >= solved.cones.length - 2 * r.cancelled_pairs, `${solved.cones.length} -> ${r.cones}`);
+  const singular = r.report.singular_vertices.filter((v) => !v.boundary);
+  if (r.defects === 0) assert.equal(singular.length, r.cones, 'one singular vertex per cone');
+  const again = new Set();
+  const r2 = session.quads(1000, (stage) => again.add(stage));
+  assert.deepEqual([...again], ['quantization', 'quad extraction'], 'the same pairs: only quantization and extraction again');
+  assert.equal(r2.cones, r.cones);
+  const fine = session.quads(10000, () => {});
+  assert.ok(fine.cancelled_pairs < r.cancelled_pairs && fine.cones > r.cones, `${fine.cancelled_pairs} pairs at 10 000 quads`);
+});
+
 test('quads of a game asset of 56 parts: every part rounded on its own, the quad mesh closed', () => {
   const session = open(sharedMesh('xatlas-gazebo'));
   session.solve(new Uint32Array(), undefined, false, () => {});

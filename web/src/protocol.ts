@@ -321,6 +321,9 @@ export interface QuadsResult {
   singular: Uint32Array;
   /** Places the extractor repaired (0 on a valid map). */
   defects: number;
+  /** Cones of the map quantized, and the pairs of opposite cones of the solve cancelled for this grid (closer than a cell's diagonal). */
+  cones: number;
+  cancelled_pairs: number;
   /** The mesh the map was solved on: its faces and the vertices inserted into the input (a low-poly mesh is refined for quads). */
   solved_faces: number;
   inserted_vertices: number;
@@ -347,7 +350,7 @@ export const QUAD_REPORT_KEYS = {
 } as const satisfies Keys<QuadReport>;
 export const QUADS_RESULT_KEYS = {
   quantization: true, report: true, uv: true, positions: true, quads: true, edges: true, singular: true, defects: true,
-  solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
+  cones: true, cancelled_pairs: true, solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
 } as const satisfies Keys<QuadsResult>;
 
 /** A solve as the page receives it: the wasm result and what the worker adds. */

@@ -285,6 +285,9 @@ function quadTable(s: Shown, counts: ReturnType<typeof valenceCounts>): HTMLDLis
     ['Quad edge length', fmt(q.grid_size, 4)],
     ['Quad vertices', fmtInt(r.vertices)],
     ['Singular vertices', `${fmtInt(counts.three)} × 3, ${fmtInt(counts.five)} × 5, ${fmtInt(counts.other)} other`],
+    ['Cones', s.result.cancelled_pairs > 0
+      ? `${fmtInt(s.result.cones)} (${fmtInt(s.result.cancelled_pairs)} pairs closer than a quad's diagonal cancelled)`
+      : fmtInt(s.result.cones)],
   ];
   if (boundarySingular > 0) rows.push(['Irregular boundary vertices', fmtInt(boundarySingular)]);
   rows.push(

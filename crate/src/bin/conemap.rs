@@ -104,6 +104,8 @@ commands:
                        integer isolines, seam translations integers. UVs
                        are then in grid units (one cell = 1.0, shifted by
                        an integer only) and the checker square is a cell.
+                       Opposite cones closer than a cell's diagonal cancel
+                       (the grid cannot keep them apart).
 
   quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG]
              [--features FEATURES.json] [--report REPORT.json] [cone options]
@@ -116,7 +118,8 @@ commands:
                        quantization, defects and per-stage timings. The
                        map is solved on the input refined to --max-edge 5%
                        or 3.5 quads, whichever is shorter (the quads lie on
-                       the input surface all the same).
+                       the input surface all the same), and opposite cones
+                       closer than a quad's diagonal cancel.
 
 options:
   -h, --help           print this help
@@ -619,7 +622,10 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     let input_file = read_input(file)?;
     let mut times = SolveTimes { import: clock.lap(), ..SolveTimes::default() };
     let features = load_features(args, &input_file.mesh)?;
-    let options = solve_options(args, &input_file.mesh, None)?;
+    let mut options = solve_options(args, &input_file.mesh, None)?;
+    if let Some(grid) = grid {
+        options = options.for_quads(&input_file.mesh, grid);
+    }
     let solution = solve_mesh(args, file, &input_file.mesh, &features, &options)?;
     let alignment = solution.feature_alignment(&input_file.mesh, &features);
     times.cones = solution.refine_seconds + solution.placement.timings.total;

@@ -67,6 +67,44 @@ pub struct ConeOptions {
     /// vertex, whose quads fold (cow's horn tips at 3 000 quads); the
     /// excess quarter turns are spread onto nearby vertices.
     pub max_cone_index: i64,
+    /// Opposite interior cones closer than this (model units) cancel, after
+    /// the moves and clean-ups (0: none). A quad grid of cell `s` cannot
+    /// keep apart two cones closer than a cell's diagonal: each is rounded
+    /// to a grid point up to half a diagonal away, so the pair lands on one
+    /// point or on two that fold the cells between them; a quad mesh wants
+    /// [`GRID_PAIR_CELLS`] `* s` ([`crate::pipeline::SolveOptions::for_quads`]).
+    pub min_pair_distance: f64,
+}
+
+/// [`ConeOptions::min_pair_distance`] for a quad grid, in grid cells: a cell's diagonal.
+pub const GRID_PAIR_CELLS: f64 = std::f64::consts::SQRT_2;
+
+/// Pairs of opposite cones among `cones` (position, index) closer than
+/// `distance`, closest first, one quarter turn each: `(a, b)` with
+/// `cones[a]` positive and `cones[b]` negative; a cone of index ±2 may be
+/// in two pairs. Greedy on distances alone, so the pairs do not depend on
+/// the order in which they cancel.
+pub fn close_pairs(cones: &[([f64; 3], i64)], distance: f64) -> Vec<(usize, usize)> {
+    let mut candidates: Vec<(f64, usize, usize)> = Vec::new();
+    for (a, &(p, ka)) in cones.iter().enumerate().filter(|c| c.1 .1 > 0) {
+        for (b, &(q, _)) in cones.iter().enumerate().filter(|c| c.1 .1 < 0) {
+            let d = crate::vec3::norm(crate::vec3::sub(p, q));
+            if d < distance {
+                candidates.extend(std::iter::repeat_n((d, a, b), ka as usize));
+            }
+        }
+    }
+    candidates.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut left: Vec<i64> = cones.iter().map(|c| c.1.abs()).collect();
+    let mut pairs = Vec::new();
+    for (_, a, b) in candidates {
+        if left[a] > 0 && left[b] > 0 {
+            left[a] -= 1;
+            left[b] -= 1;
+            pairs.push((a, b));
+        }
+    }
+    pairs
 }
 
 /// What the boundary of the input mesh must do (features are always aligned).
@@ -109,6 +147,7 @@ impl Default for ConeOptions {
             rounding: RoundingRule::PerCluster,
             boundary: BoundaryMode::Aligned,
             max_cone_index: 1,
+            min_pair_distance: 0.0,
         }
     }
 }
@@ -234,6 +273,16 @@ pub struct ConePlacement {
 }
 
 impl ConePlacement {
+    /// The pairs of opposite interior cones (cut-mesh vertices, positive
+    /// first) closer than `distance` ([`close_pairs`]): those that
+    /// [`ConeOptions::min_pair_distance`] `= distance` cancels.
+    pub fn close_pairs(&self, distance: f64) -> Vec<(u32, u32)> {
+        let cm = &self.cut.mesh;
+        let cones: Vec<u32> = (0..cm.n_vertices() as u32).filter(|&v| self.k[v as usize] != 0 && !cm.is_boundary_vertex(v)).collect();
+        let located: Vec<([f64; 3], i64)> = cones.iter().map(|&v| (cm.position(v), self.k[v as usize] as i64)).collect();
+        close_pairs(&located, distance).into_iter().map(|(a, b)| (cones[a], cones[b])).collect()
+    }
+
     /// Sets the index of cut vertices to what a map realized (`(cut
     /// vertex, k)` pairs, inside or on the cut mesh's boundary) and lists
     /// the cones and corners again. A map realizes each angle up to

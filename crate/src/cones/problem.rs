@@ -78,6 +78,7 @@ fn improve(
     } else {
         0
     };
+    let cancelled = cancelled + if options.min_pair_distance > 0.0 { sys.cancel_close_pairs(options.min_pair_distance)? } else { 0 };
     // After the clean-ups, so that none of them gathers the quarter turns
     // again; the moves that follow keep every cone within the bound.
     let spread = sys.spread_degenerate_cones(options.max_cone_index)?;

@@ -78,3 +78,38 @@ fn ring_with_flap_gets_cones_where_miq_emulation_gets_none() {
     assert!(miq.cones.is_empty(), "MIQ emulation: {:?}", miq.cones);
     assert!(!ours.cones.is_empty(), "the method must place cones to avoid the collapse");
 }
+
+/// Opposite interior cones closer than `min_pair_distance` cancel (a quad
+/// grid cannot keep them apart) and Gauss-Bonnet still holds; a distance
+/// beyond every pair leaves a bump without cones.
+#[test]
+fn close_opposite_cones_cancel_for_a_coarse_grid() {
+    let mesh = grid(24, 24, |x, y| [x, y, 0.5 * (-40.0 * ((x - 0.5).powi(2) + (y - 0.5).powi(2))).exp()]);
+    let with = |d: f64| {
+        let options = ConeOptions { min_pair_distance: d, ..ConeOptions::default() };
+        place_cones(&mesh, &FeatureSet::none(&mesh), &options, &mut |_| {}).unwrap()
+    };
+    let kept = with(0.0);
+    assert_gauss_bonnet(&mesh, &kept);
+    let turns = |r: &ConePlacement| r.cones.iter().map(|c| c.k.abs()).sum::<i32>();
+    let d = 0.3;
+    let pairs = kept.close_pairs(d);
+    assert!(!pairs.is_empty() && pairs.len() < turns(&kept) as usize / 2, "{pairs:?}");
+    let cancelled = with(d);
+    assert_gauss_bonnet(&mesh, &cancelled);
+    assert!(cancelled.close_pairs(d).is_empty());
+    assert_eq!(turns(&cancelled), turns(&kept) - 2 * pairs.len() as i32);
+    let none = with(2.0);
+    assert_gauss_bonnet(&mesh, &none);
+    assert!(none.cones.is_empty(), "cones: {:?}", none.cones);
+}
+
+/// [`close_pairs`]: closest first, each quarter turn in one pair (a cone
+/// of index -2 in two), none at or beyond the distance.
+#[test]
+fn close_pairs_are_greedy_by_distance() {
+    let at = |x: f64, k: i64| ([x, 0.0, 0.0], k);
+    let cones = [at(0.0, 1), at(0.3, -1), at(0.5, 1), at(1.0, -2), at(1.25, 1), at(5.0, -1), at(5.9, 1), at(1.6, 1)];
+    assert_eq!(close_pairs(&cones, 0.9), vec![(2, 1), (4, 3), (7, 3)]);
+    assert_eq!(close_pairs(&cones, 0.15), vec![]);
+}

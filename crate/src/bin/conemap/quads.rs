@@ -28,7 +28,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let import = clock.lap();
     let features = load_features(args, &input.mesh)?;
     let max_edge = conemap::pipeline::RefineOptions::for_quads(&input.mesh, grid).max_edge_length;
-    let options = solve_options(args, &input.mesh, max_edge)?;
+    let options = solve_options(args, &input.mesh, max_edge)?.for_quads(&input.mesh, grid);
     let solution = solve_mesh(args, file, &input.mesh, &features, &options)?;
     let solve = clock.lap();
     let map = quantize(file, &solution, grid, &QuantizeOptions::default())?;

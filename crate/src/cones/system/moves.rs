@@ -441,6 +441,24 @@ impl ComponentSystem<'_> {
         Ok(merged)
     }
 
+    /// Cancels the pairs of opposite interior cones closer than `distance`
+    /// ([`crate::cones::close_pairs`]) whatever the objective says: a grid
+    /// that cannot keep them apart asks for it
+    /// ([`crate::cones::ConeOptions::min_pair_distance`]). Returns the
+    /// quarter turns cancelled.
+    pub fn cancel_close_pairs(&mut self, distance: f64) -> Result<usize, ConeError> {
+        let cones = self.interior_cones();
+        let located: Vec<([f64; 3], i64)> = cones.iter().map(|&(i, k)| (self.mesh.position(self.tree.vertices[i]), k)).collect();
+        let moves: Vec<Transfer> = crate::cones::close_pairs(&located, distance).into_iter().map(|(a, b)| (cones[a].0, cones[b].0, 1)).collect();
+        if moves.is_empty() {
+            return Ok(0);
+        }
+        let dx = self.responses(std::slice::from_ref(&moves))?;
+        self.accept(&moves, &dx);
+        self.solve_unknowns()?;
+        Ok(moves.len())
+    }
+
     /// Pair cancellation by descent on the objective (an extension of the
     /// paper's clean-up to distant pairs): for each interior cone, tries
     /// cancelling it against each of its `nearest` closest cones of opposite
