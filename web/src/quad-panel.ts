@@ -260,7 +260,7 @@ export class QuadPanel {
     if (bytes) downloadBytes(bytes, type, `${fileStem(this.mesh?.label)}-${suffix}`);
   }
 
-  /** The progress line for a report of `stage` (quantization: `step` of `remaining` forms rounded). */
+  /** The progress line for a report of `stage` (quantization: `step` of `remaining` forms rounded; any other: a stage of the map solved again for the quad size). */
   private setProgress(stage: string, step = 0, remaining = 0): void {
     let text = 'Starting…';
     let frac: number | undefined;
@@ -269,6 +269,9 @@ export class QuadPanel {
       frac = remaining ? step / remaining : undefined;
     } else if (stage === 'quad extraction') {
       text = 'Quad extraction';
+    } else if (stage !== 'starting') {
+      // The map solved again for this quad size (edges split, or cone pairs cancelled).
+      text = `Map for this quad size: ${stage}`;
     }
     this.el.stage.textContent = text;
     if (frac === undefined) this.el.bar.removeAttribute('value');

@@ -274,13 +274,21 @@ pub struct ConePlacement {
 
 impl ConePlacement {
     /// The pairs of opposite interior cones (cut-mesh vertices, positive
-    /// first) closer than `distance` ([`close_pairs`]): those that
-    /// [`ConeOptions::min_pair_distance`] `= distance` cancels.
+    /// first) closer than `distance` ([`close_pairs`], within each
+    /// component): those that [`ConeOptions::min_pair_distance`] `=
+    /// distance` cancels.
     pub fn close_pairs(&self, distance: f64) -> Vec<(u32, u32)> {
         let cm = &self.cut.mesh;
-        let cones: Vec<u32> = (0..cm.n_vertices() as u32).filter(|&v| self.k[v as usize] != 0 && !cm.is_boundary_vertex(v)).collect();
-        let located: Vec<([f64; 3], i64)> = cones.iter().map(|&v| (cm.position(v), self.k[v as usize] as i64)).collect();
-        close_pairs(&located, distance).into_iter().map(|(a, b)| (cones[a], cones[b])).collect()
+        let mut by_component = vec![Vec::new(); cm.n_components()];
+        for v in (0..cm.n_vertices() as u32).filter(|&v| self.k[v as usize] != 0 && !cm.is_boundary_vertex(v)) {
+            by_component[cm.vertex_component(v)].push(v);
+        }
+        let mut pairs = Vec::new();
+        for cones in by_component {
+            let located: Vec<([f64; 3], i64)> = cones.iter().map(|&v| (cm.position(v), self.k[v as usize] as i64)).collect();
+            pairs.extend(close_pairs(&located, distance).into_iter().map(|(a, b)| (cones[a], cones[b])));
+        }
+        pairs
     }
 
     /// Sets the index of cut vertices to what a map realized (`(cut
