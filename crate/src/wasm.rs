@@ -93,12 +93,12 @@ struct GridStage {
 }
 
 /// The map of [`GridStage::solution`] solved again with the cone pairs
-/// `pairs` (cut vertices, [`cones::ConePlacement::close_pairs`]) cancelled,
-/// kept while the quad count asked for cancels the same pairs.
+/// `pairs` (cut vertices, [`cones::ConePlacement::close_pairs`]) cancelled
+/// and its quantizer (`None` where that solve failed: not tried again for
+/// the same pairs), kept while the quad count asked for cancels the same pairs.
 struct Paired {
     pairs: Vec<(u32, u32)>,
-    solution: Solution<'static>,
-    quantizer: Quantizer,
+    solved: Option<(Solution<'static>, Quantizer)>,
 }
 
 /// A solve run in steps: its features and settings, its cone stage and the
@@ -355,12 +355,13 @@ impl MeshSession {
             let options = grid.options.for_quads(input, size);
             let solved = pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress));
             // Where that fails, quads on the map without.
-            grid.paired = solved.ok().and_then(|sol| Some(Paired { quantizer: sol.quantizer().ok()?, pairs: pairs.clone(), solution: sol.into_owned() }));
+            let solved = solved.ok().and_then(|sol| Some((sol.quantizer().ok()?, sol.into_owned())));
+            grid.paired = Some(Paired { pairs: pairs.clone(), solved: solved.map(|(q, sol)| (sol, q)) });
         }
         let input = self.valid_mesh()?;
         let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
         let (sol, quantizer, cancelled_pairs) = match &grid.paired {
-            Some(p) if !pairs.is_empty() && p.pairs == pairs => (&p.solution, &p.quantizer, pairs.len()),
+            Some(Paired { pairs: p, solved: Some((solution, quantizer)) }) if !pairs.is_empty() && *p == pairs => (solution, quantizer, pairs.len()),
             _ => (&grid.solution, grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0),
         };
         let map = quantizer

@@ -449,14 +449,16 @@ impl ComponentSystem<'_> {
     pub fn cancel_close_pairs(&mut self, distance: f64) -> Result<usize, ConeError> {
         let cones = self.interior_cones();
         let located: Vec<([f64; 3], i64)> = cones.iter().map(|&(i, k)| (self.mesh.position(self.tree.vertices[i]), k)).collect();
-        let moves: Vec<Transfer> = crate::cones::close_pairs(&located, distance).into_iter().map(|(a, b)| (cones[a].0, cones[b].0, 1)).collect();
-        if moves.is_empty() {
+        let pairs = crate::cones::close_pairs(&located, distance);
+        if pairs.is_empty() {
             return Ok(0);
         }
-        let dx = self.responses(std::slice::from_ref(&moves))?;
-        self.accept(&moves, &dx);
+        // One exact solve for all of them (no trial to rank).
+        for &(a, b) in &pairs {
+            self.transfer((cones[a].0, cones[b].0, 1));
+        }
         self.solve_unknowns()?;
-        Ok(moves.len())
+        Ok(pairs.len())
     }
 
     /// Pair cancellation by descent on the objective (an extension of the
