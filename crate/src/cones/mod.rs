@@ -236,7 +236,8 @@ pub struct ComponentFigures {
     pub h: Vec<f64>,
     pub rounds: usize,
     pub moves: usize,
-    /// Opposite cone pairs cancelled by the close-pair clean-up and by descent.
+    /// Opposite cone pairs cancelled by the close-pair clean-up, and by
+    /// descent and for a quad grid ([`ConeOptions::min_pair_distance`]).
     pub merged_pairs: usize,
     pub cancelled_pairs: usize,
     /// Quarter turns moved off cones of index above 3 (`spread_degenerate_cones`).

@@ -1423,11 +1423,9 @@ impl Quantizer {
             .collect()
     }
 
+    /// Triangles of `x` flipped or degenerate ([`local::inverted_faces`]).
     fn flipped(&self, x: &[f64]) -> usize {
-        self.elements
-            .iter()
-            .filter(|el| !(signed_uv_area(el.unknowns_uv(x)) > 0.0))
-            .count()
+        local::inverted_faces(&self.elements, x).len()
     }
 
     /// Widens held rows so that the pairs whose rows the solve dropped are

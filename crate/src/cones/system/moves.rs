@@ -445,7 +445,7 @@ impl ComponentSystem<'_> {
     /// ([`crate::cones::close_pairs`]) whatever the objective says: a grid
     /// that cannot keep them apart asks for it
     /// ([`crate::cones::ConeOptions::min_pair_distance`]). Returns the
-    /// quarter turns cancelled.
+    /// pairs cancelled.
     pub fn cancel_close_pairs(&mut self, distance: f64) -> Result<usize, ConeError> {
         let cones = self.interior_cones();
         let located: Vec<([f64; 3], i64)> = cones.iter().map(|&(i, k)| (self.mesh.position(self.tree.vertices[i]), k)).collect();
