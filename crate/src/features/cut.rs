@@ -114,7 +114,8 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
 /// loop the rounding errors add up, and a small region enclosed by it would
 /// need cones of angle `<= 0`. Where the two differ by [`MAX_ROUNDING_DRIFT`]
 /// or more, the corners whose rounding was closest to going the other way
-/// are moved until the difference is gone (sum-preserving rounding). Where
+/// are moved until the difference is gone (sum-preserving rounding), equally
+/// close ones spread apart ([`spread_ties`]). Where
 /// the 90° bound leaves no corner to move, the pipeline refines
 /// ([`super::refine_for_features`], [`super::split_around`]).
 pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
@@ -144,9 +145,9 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
         }
         let step: i32 = if sum[c] < target { 1 } else { -1 };
         let mut need = (target - sum[c]).unsigned_abs() as usize;
+        need -= spread_along_loops(mesh, c, step, need, &turning, &mut k);
         while need > 0 {
-            // How close each corner's rounding was to going the other way;
-            // exact ties (a regular polygon) are spread by a hash of the vertex.
+            // How close each corner's rounding was to going the other way.
             let mut order: Vec<(f64, u64, u32)> = corners[c]
                 .iter()
                 .filter(|&&v| step < 0 || k[v as usize] < 1)
@@ -157,13 +158,95 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
             }
             order.sort_by(closest_first);
             let moved = need.min(order.len());
-            for &(_, _, v) in &order[..moved] {
+            for v in spread_ties(mesh, &order, moved) {
                 k[v as usize] += step;
             }
             need -= moved;
         }
     }
     k
+}
+
+/// Moves up to `need` corners of component `c` by `step`, loop by loop:
+/// each boundary loop takes a share of `need` in proportion to the turning
+/// its corners' rounding lost in the direction of `step` (largest
+/// remainders, at most that turning rounded), and moves its own corners in
+/// the order of [`boundary_turning`] ([`spread_ties`]). A circle's lost
+/// turning goes back to that circle: a plate with three round holes gets
+/// four corners on each, where the component-wide order put six on the two
+/// that turned most per vertex and none on the third. Returns the moves made.
+fn spread_along_loops(mesh: &TriMesh, c: usize, step: i32, need: usize, turning: &[f64], k: &mut [i32]) -> usize {
+    let loops: Vec<Vec<u32>> = (0..mesh.boundary_loops().len())
+        .map(|i| mesh.boundary_loop_vertices(i))
+        .filter(|l| l.first().is_some_and(|&v| mesh.vertex_component(v) == c))
+        .collect();
+    let closeness = |v: u32, k: &[i32]| step as f64 * (turning[v as usize] - k[v as usize] as f64);
+    let lost: Vec<f64> = loops.iter().map(|l| l.iter().map(|&v| closeness(v, k)).sum::<f64>().max(0.0)).collect();
+    let all: f64 = lost.iter().sum();
+    if !(all > 0.0) {
+        return 0;
+    }
+    let exact: Vec<f64> = lost.iter().map(|d| need as f64 * d / all).collect();
+    let mut share: Vec<usize> = exact.iter().map(|e| e.floor() as usize).collect();
+    let mut by_remainder: Vec<usize> = (0..loops.len()).collect();
+    by_remainder.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())).then(a.cmp(&b)));
+    let left = need.saturating_sub(share.iter().sum::<usize>()); // < loops.len(): the remainders add to less
+    for &l in by_remainder.iter().take(left) {
+        share[l] += 1;
+    }
+    let mut moved = 0;
+    for (l, vertices) in loops.iter().enumerate() {
+        let n = share[l].min(lost[l].round() as usize);
+        let mut order: Vec<(f64, u64, u32)> = vertices
+            .iter()
+            .filter(|&&v| (step < 0 || k[v as usize] < 1) && closeness(v, k) > 0.0)
+            .map(|&v| (closeness(v, k), spread(v), v))
+            .collect();
+        order.sort_by(closest_first);
+        for v in spread_ties(mesh, &order, n.min(order.len())) {
+            k[v as usize] += step;
+            moved += 1;
+        }
+    }
+    moved
+}
+
+/// Closeness (quarter turns, about 2°) within which two corners are equally
+/// sharp for [`spread_ties`].
+const SAME_TURNING: f64 = 1e-3;
+
+/// The first `count` corners of `order` (sorted by [`closest_first`]), save
+/// that among corners within [`SAME_TURNING`] of the closest one left, the
+/// one farthest from those picked already is picked next. A round hole,
+/// whose vertices all turn alike, gets its corners evenly spaced, as a
+/// square hole's; by closeness alone they follow the rounding noise of the
+/// export (a CAD bracket's holes: three corners within 15°, twice).
+fn spread_ties(mesh: &TriMesh, order: &[(f64, u64, u32)], count: usize) -> Vec<u32> {
+    let mut picked = Vec::with_capacity(count);
+    let mut taken = vec![false; order.len()];
+    // Squared distance of each corner to the nearest picked one.
+    let mut gap = vec![f64::INFINITY; order.len()];
+    for _ in 0..count {
+        let Some(first) = taken.iter().position(|t| !t) else { break };
+        let equal = order[first].0 - SAME_TURNING;
+        let mut best = first;
+        for i in first..order.len() {
+            if order[i].0 < equal {
+                break;
+            }
+            if !taken[i] && gap[i] > gap[best] {
+                best = i;
+            }
+        }
+        taken[best] = true;
+        let p = mesh.position(order[best].2);
+        picked.push(order[best].2);
+        for (i, g) in gap.iter_mut().enumerate() {
+            let q = mesh.position(order[i].2);
+            *g = g.min((0..3).map(|a| (p[a] - q[a]).powi(2)).sum());
+        }
+    }
+    picked
 }
 
 /// Order of corners `(closeness, tie hash, vertex)` for [`boundary_turning`]:
@@ -190,8 +273,32 @@ fn spread(v: u32) -> u64 {
 
 #[cfg(test)]
 mod tests {
-    use super::closest_first;
+    use super::{boundary_turning, closest_first};
+    use crate::cones::test_meshes::square_with_round_hole;
     use std::cmp::Ordering;
+
+    /// A round hole in a flat square turns a full circle in steps that each
+    /// round to no corner; the four concave corners it needs (Gauss-Bonnet)
+    /// are spaced evenly around it, as a square hole's, not bunched where
+    /// a tie-break hash put them.
+    #[test]
+    fn a_round_hole_gets_four_evenly_spaced_corners() {
+        let n = 12;
+        let mesh = square_with_round_hole(n, 4, 0.4);
+        let k = boundary_turning(&mesh);
+        let hole = (0..mesh.boundary_loops().len())
+            .map(|i| mesh.boundary_loop_vertices(i))
+            .find(|l| mesh.position(l[0])[0].hypot(mesh.position(l[0])[1]) < 0.5)
+            .expect("the hole is a boundary loop");
+        let corners: Vec<usize> = (0..hole.len()).filter(|&i| k[hole[i] as usize] != 0).collect();
+        assert!(corners.iter().all(|&i| k[hole[i] as usize] == -1), "{:?}", corners.iter().map(|&i| k[hole[i] as usize]).collect::<Vec<_>>());
+        assert_eq!(corners.len(), 4, "corners at {corners:?}");
+        for (a, b) in corners.iter().zip(corners.iter().cycle().skip(1)) {
+            assert_eq!((b + hole.len() - a) % hole.len(), n, "corners at {corners:?} of {}", hole.len());
+        }
+        let outer: i32 = (0..mesh.n_vertices()).filter(|&v| !hole.contains(&(v as u32))).map(|v| k[v]).sum();
+        assert_eq!(outer, 4, "the square keeps its four convex corners");
+    }
 
     /// Corners whose closeness differs by less than the old 1e-9 tolerance in
     /// a chain (a ~ b, b ~ c, a !~ c) are still ordered consistently:
