@@ -113,8 +113,11 @@ pub fn cut_open(mesh: &TriMesh, features: &FeatureSet) -> CutMesh {
 /// angle defect `K` of the interior vertices. Along a long or jagged feature
 /// loop the rounding errors add up, and a small region enclosed by it would
 /// need cones of angle `<= 0`. Where the two differ by [`MAX_ROUNDING_DRIFT`]
-/// or more, the corners whose rounding was closest to going the other way
-/// are moved until the difference is gone (sum-preserving rounding), equally
+/// or more, corners are moved by a quarter turn until the difference is gone
+/// (sum-preserving rounding): first each loop gets back a share in
+/// proportion to the turning its own rounding lost ([`spread_along_loops`]),
+/// then the corners of the component take the rest; each time the corners
+/// whose rounding was closest to going the other way move first, equally
 /// close ones spread apart ([`spread_ties`]). Where
 /// the 90° bound leaves no corner to move, the pipeline refines
 /// ([`super::refine_for_features`], [`super::split_around`]).
@@ -129,6 +132,11 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
     let mut corners: Vec<Vec<u32>> = vec![Vec::new(); nc];
     let mut sum = vec![0i64; nc];
     let mut interior_defect = vec![0.0f64; nc];
+    let mut loops: Vec<Vec<Vec<u32>>> = vec![Vec::new(); nc];
+    for i in 0..mesh.boundary_loops().len() {
+        let vertices = mesh.boundary_loop_vertices(i);
+        loops[mesh.vertex_component(vertices[0])].push(vertices);
+    }
     for v in 0..nv as u32 {
         let c = mesh.vertex_component(v);
         if mesh.is_boundary_vertex(v) {
@@ -145,7 +153,7 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
         }
         let step: i32 = if sum[c] < target { 1 } else { -1 };
         let mut need = (target - sum[c]).unsigned_abs() as usize;
-        need -= spread_along_loops(mesh, c, step, need, &turning, &mut k);
+        need -= spread_along_loops(mesh, &loops[c], step, need, &turning, &mut k);
         while need > 0 {
             // How close each corner's rounding was to going the other way.
             let mut order: Vec<(f64, u64, u32)> = corners[c]
@@ -167,7 +175,8 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
     k
 }
 
-/// Moves up to `need` corners of component `c` by `step`, loop by loop:
+/// Moves up to `need` corners of one component's boundary `loops` (vertices
+/// in loop order) by `step`, loop by loop:
 /// each boundary loop takes a share of `need` in proportion to the turning
 /// its corners' rounding lost in the direction of `step` (largest
 /// remainders, at most that turning rounded), and moves its own corners in
@@ -175,11 +184,7 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
 /// turning goes back to that circle: a plate with three round holes gets
 /// four corners on each, where the component-wide order put six on the two
 /// that turned most per vertex and none on the third. Returns the moves made.
-fn spread_along_loops(mesh: &TriMesh, c: usize, step: i32, need: usize, turning: &[f64], k: &mut [i32]) -> usize {
-    let loops: Vec<Vec<u32>> = (0..mesh.boundary_loops().len())
-        .map(|i| mesh.boundary_loop_vertices(i))
-        .filter(|l| l.first().is_some_and(|&v| mesh.vertex_component(v) == c))
-        .collect();
+fn spread_along_loops(mesh: &TriMesh, loops: &[Vec<u32>], step: i32, need: usize, turning: &[f64], k: &mut [i32]) -> usize {
     let closeness = |v: u32, k: &[i32]| step as f64 * (turning[v as usize] - k[v as usize] as f64);
     let lost: Vec<f64> = loops.iter().map(|l| l.iter().map(|&v| closeness(v, k)).sum::<f64>().max(0.0)).collect();
     let all: f64 = lost.iter().sum();
@@ -211,8 +216,9 @@ fn spread_along_loops(mesh: &TriMesh, c: usize, step: i32, need: usize, turning:
     moved
 }
 
-/// Closeness (quarter turns, about 2°) within which two corners are equally
-/// sharp for [`spread_ties`].
+/// Closeness (quarter turns; 0.09°) within which two corners are equally
+/// sharp for [`spread_ties`]: far above an export's float noise (1e-5 on a
+/// CAD circle), far below the turning of a corner.
 const SAME_TURNING: f64 = 1e-3;
 
 /// The first `count` corners of `order` (sorted by [`closest_first`]), save
