@@ -192,13 +192,13 @@ describe('quad mode', () => {
   });
 
   it('traces the quads of a low-poly CAD cylinder on a map solved again on its refinement', async () => {
-    const n = 24;
+    const n = 20;
     const loads = (await hooks()).loads;
     await page.getByTestId('file-input').setInputFiles({ name: 'cylinder.obj', mimeType: 'text/plain', buffer: Buffer.from(cadCylinderObj(n)) });
     await page.waitForFunction((k) => window.__conemap.loads > k && window.__conemap.state !== 'loading', loads, { timeout: LOAD_TIMEOUT });
     await page.getByTestId('sharp-toggle').check();
     await page.getByTestId('sharp-angle').fill('60');
-    await page.waitForFunction(() => window.__conemap.features === 48, null, { timeout: 10_000 });
+    await page.waitForFunction((k) => window.__conemap.features === k, 2 * n, { timeout: 10_000 });
     let h = await hooks();
     const { solves, quadRuns } = h;
     await page.getByTestId('run').click();

@@ -85,11 +85,16 @@ test('quads returns exactly the fields of QuadsResult: a valid quad mesh, grid U
 });
 
 test('quads of a low-poly mesh are traced on a map solved again on its refinement, once', () => {
-  const session = wasm.MeshSession.open([{ name: 'cylinder.obj', bytes: new TextEncoder().encode(cadCylinderObj(24)) }]);
+  // 20 segments: the UV map keeps the input triangles (from 24 segments up
+  // it splits long edges: its caps' corners, spread 90° apart, fold the
+  // fans of thin triangles; bunched, they gave maps of distortion 0.44-0.66).
+  const n = 20;
+  const session = wasm.MeshSession.open([{ name: 'cylinder.obj', bytes: new TextEncoder().encode(cadCylinderObj(n)) }]);
   const faces = session.indices().length / 3;
-  assert.equal(faces, 4 * 24 - 4);
+  assert.equal(faces, 4 * n - 4);
   const solved = session.solve(session.sharp_edges(60), undefined, false, () => {});
   assert.equal(solved.refinement.long_edges, 0, 'the UV map keeps the input triangles');
+  assert.ok(solved.metrics.distortion < 0.25, `distortion ${solved.metrics.distortion}`);
   const stages = new Set();
   const r = session.quads(1000, (stage) => stages.add(stage));
   assert.ok(stages.has('rounding') && stages.has('quantization'), [...stages].join(', '));
