@@ -355,8 +355,11 @@ impl MeshSession {
             let options = grid.options.for_quads(input, size);
             let solved = pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress));
             // Where that fails, quads on the map without.
-            let solved = solved.ok().and_then(|sol| Some((sol.quantizer().ok()?, sol.into_owned())));
-            grid.paired = Some(Paired { pairs: pairs.clone(), solved: solved.map(|(q, sol)| (sol, q)) });
+            let solved = solved.ok().and_then(|sol| {
+                let quantizer = sol.quantizer().ok()?;
+                Some((sol.into_owned(), quantizer))
+            });
+            grid.paired = Some(Paired { pairs: pairs.clone(), solved });
         }
         let input = self.valid_mesh()?;
         let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;

@@ -3,6 +3,7 @@
 
 use super::FeatureSet;
 use crate::mesh::{TriMesh, UnionFind, NONE};
+use crate::vec3::{dot, sub};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// A mesh cut open along its feature edges.
@@ -155,16 +156,10 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
         let mut need = (target - sum[c]).unsigned_abs() as usize;
         need -= spread_along_loops(mesh, &loops[c], step, need, &turning, &mut k);
         while need > 0 {
-            // How close each corner's rounding was to going the other way.
-            let mut order: Vec<(f64, u64, u32)> = corners[c]
-                .iter()
-                .filter(|&&v| step < 0 || k[v as usize] < 1)
-                .map(|&v| (step as f64 * (turning[v as usize] - k[v as usize] as f64), spread(v), v))
-                .collect();
+            let order = closest_order(&corners[c], step, &turning, &k);
             if order.is_empty() {
                 break;
             }
-            order.sort_by(closest_first);
             let moved = need.min(order.len());
             for v in spread_ties(mesh, &order, moved) {
                 k[v as usize] += step;
@@ -185,8 +180,7 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
 /// four corners on each, where the component-wide order put six on the two
 /// that turned most per vertex and none on the third. Returns the moves made.
 fn spread_along_loops(mesh: &TriMesh, loops: &[Vec<u32>], step: i32, need: usize, turning: &[f64], k: &mut [i32]) -> usize {
-    let closeness = |v: u32, k: &[i32]| step as f64 * (turning[v as usize] - k[v as usize] as f64);
-    let lost: Vec<f64> = loops.iter().map(|l| l.iter().map(|&v| closeness(v, k)).sum::<f64>().max(0.0)).collect();
+    let lost: Vec<f64> = loops.iter().map(|l| l.iter().map(|&v| closeness(v, step, turning, k)).sum::<f64>().max(0.0)).collect();
     let all: f64 = lost.iter().sum();
     if !(all > 0.0) {
         return 0;
@@ -202,18 +196,32 @@ fn spread_along_loops(mesh: &TriMesh, loops: &[Vec<u32>], step: i32, need: usize
     let mut moved = 0;
     for (l, vertices) in loops.iter().enumerate() {
         let n = share[l].min(lost[l].round() as usize);
-        let mut order: Vec<(f64, u64, u32)> = vertices
-            .iter()
-            .filter(|&&v| (step < 0 || k[v as usize] < 1) && closeness(v, k) > 0.0)
-            .map(|&v| (closeness(v, k), spread(v), v))
-            .collect();
-        order.sort_by(closest_first);
+        let mut order = closest_order(vertices, step, turning, k);
+        order.retain(|c| c.0 > 0.0);
         for v in spread_ties(mesh, &order, n.min(order.len())) {
             k[v as usize] += step;
             moved += 1;
         }
     }
     moved
+}
+
+/// How close corner `v`'s rounding was to going the other way, in the
+/// direction of `step`: `step (t_v - k_v)` quarter turns.
+fn closeness(v: u32, step: i32, turning: &[f64], k: &[i32]) -> f64 {
+    step as f64 * (turning[v as usize] - k[v as usize] as f64)
+}
+
+/// The `corners` that may move by `step` (none above 1), as `(closeness,
+/// tie hash, vertex)` sorted by [`closest_first`].
+fn closest_order(corners: &[u32], step: i32, turning: &[f64], k: &[i32]) -> Vec<(f64, u64, u32)> {
+    let mut order: Vec<(f64, u64, u32)> = corners
+        .iter()
+        .filter(|&&v| step < 0 || k[v as usize] < 1)
+        .map(|&v| (closeness(v, step, turning, k), spread(v), v))
+        .collect();
+    order.sort_by(closest_first);
+    order
 }
 
 /// Closeness (quarter turns; 0.09°) within which two corners are equally
@@ -248,8 +256,8 @@ fn spread_ties(mesh: &TriMesh, order: &[(f64, u64, u32)], count: usize) -> Vec<u
         let p = mesh.position(order[best].2);
         picked.push(order[best].2);
         for (i, g) in gap.iter_mut().enumerate() {
-            let q = mesh.position(order[i].2);
-            *g = g.min((0..3).map(|a| (p[a] - q[a]).powi(2)).sum());
+            let d = sub(p, mesh.position(order[i].2));
+            *g = g.min(dot(d, d));
         }
     }
     picked
