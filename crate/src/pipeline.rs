@@ -17,8 +17,10 @@ use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrizatio
 use std::borrow::Cow;
 use std::fmt;
 
+mod grid;
 mod location;
 mod parts;
+pub use grid::{grid_map, GridMapped};
 pub use location::{enclosing_features, ErrorLocation, MAX_LOCATION_EDGES};
 use location::Lift;
 use parts::Parts;

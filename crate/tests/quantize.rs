@@ -476,6 +476,35 @@ fn a_low_poly_cad_cylinder_is_refined_for_quads() {
     assert_eq!((uncornered.quads, uncornered.euler_characteristic), (after.quads, 2));
 }
 
+/// A CAD kernel's gear (`tests/fixtures/cad/gear.obj`: 288 long, thin
+/// triangles) solved for an integer-grid map as `solve --quads` solves it:
+/// where the grid map of the input's triangles folds, `pipeline::grid_map`
+/// solves again on the refinement a quad mesh of that grid keeps, and its
+/// map has no flipped triangle, winds around no vertex and is an integer
+/// grid.
+#[test]
+fn a_low_poly_cad_grid_map_is_solved_again_where_it_folds() {
+    use conemap::pipeline::grid_map;
+    let input = common::fixture_mesh("cad/gear.obj");
+    let features = FeatureSet::sharp_edges(&input, 60.0);
+    let quantize = QuantizeOptions { retry_wound: true };
+    let mut folded_on_input = 0;
+    for quads in [2000, 3000, 4000] {
+        let name = format!("gear at {quads} quads");
+        let options = SolveOptions::default().for_quads(&input, GridSize::Quads(quads));
+        let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
+        let first = solution.quantizer().unwrap().quantize_with(&solution.mesh, GridSize::Quads(quads), &quantize, &mut |_, _| {}).unwrap();
+        let input_faults = first.report.flipped + first.report.wound_vertices;
+        folded_on_input += usize::from(input_faults > 0);
+        let mapped = grid_map(&input, &features, &options, solution, GridSize::Quads(quads), &quantize, &mut |_| {}, &mut |_, _| {}).unwrap();
+        let (r, mesh) = (&mapped.map.report, &mapped.solution.mesh);
+        assert_eq!((r.flipped, r.wound_vertices), (0, 0), "{name}: {r:?}");
+        assert_eq!(mesh.n_faces() > input.n_faces(), input_faults > 0, "{name}: solved again exactly where the input's map folds");
+        let (flipped, off_grid) = check_integer_grid(&name, mesh, &mapped.solution.features, &mapped.map.uv);
+        assert_eq!((flipped, off_grid), (0, 0), "{name}");
+    }
+    assert!(folded_on_input > 0, "the input's own grid map no longer folds at any count: this test no longer exercises the second solve");
+}
 
 /// A feature curve that ends inside the surface is an isoline running on
 /// through its end, so only its constant is an integer: with the end's

@@ -105,7 +105,11 @@ commands:
                        are then in grid units (one cell = 1.0, shifted by
                        an integer only) and the checker square is a cell.
                        Opposite cones closer than a cell's diagonal cancel
-                       (the grid cannot keep them apart).
+                       (the grid cannot keep them apart). Where that map
+                       folds on a mesh with edges longer than such quads
+                       (a low-poly CAD export), it is solved again with
+                       those edges split; the output is then the refined
+                       mesh.
 
   quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG]
              [--features FEATURES.json] [--report REPORT.json] [cone options]
@@ -515,6 +519,13 @@ impl ProgressLine {
         });
     }
 
+    fn solve(&self, p: conemap::pipeline::SolveProgress) {
+        match p {
+            conemap::pipeline::SolveProgress::Cones(p) => self.cones(&p),
+            conemap::pipeline::SolveProgress::Param(p) => self.param(&p),
+        }
+    }
+
     fn finish(&self) {
         if let Some(bar) = &self.0 {
             bar.finish_and_clear();
@@ -626,14 +637,21 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     if let Some(grid) = grid {
         options = options.for_quads(&input_file.mesh, grid);
     }
-    let solution = solve_mesh(args, file, &input_file.mesh, &features, &options)?;
-    let alignment = solution.feature_alignment(&input_file.mesh, &features);
+    let mut solution = solve_mesh(args, file, &input_file.mesh, &features, &options)?;
     times.cones = solution.refine_seconds + solution.placement.timings.total;
     times.param = clock.lap() - times.cones;
-    let grid_map = match grid {
-        Some(size) => Some(quantize(file, &solution, size, &QuantizeOptions { retry_wound: true })?),
-        None => None,
-    };
+    let mut grid_map = None;
+    if let Some(size) = grid {
+        // A map solved again on the refinement for quads (where the input's
+        // grid map folds) counts as quantization time.
+        let bar = ProgressLine::new(args);
+        let quantize = QuantizeOptions { retry_wound: true };
+        let mapped = conemap::pipeline::grid_map(&input_file.mesh, &features, &options, solution, size, &quantize, &mut |p| bar.solve(p), &mut |_, _| {});
+        bar.finish();
+        let mapped = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+        (solution, grid_map) = (mapped.solution, Some(mapped.map));
+    }
+    let alignment = solution.feature_alignment(&input_file.mesh, &features);
     times.quantize = clock.lap();
     let uv = grid_map.as_ref().map(|g| &g.uv).unwrap_or(&solution.param.uv);
 
@@ -688,10 +706,7 @@ fn solve_mesh<'a>(
 ) -> Result<conemap::pipeline::Solution<'a>, Failure> {
     use conemap::pipeline;
     let bar = ProgressLine::new(args);
-    let solution = pipeline::solve(mesh, features, options, &mut |p| match p {
-        pipeline::SolveProgress::Cones(p) => bar.cones(&p),
-        pipeline::SolveProgress::Param(p) => bar.param(&p),
-    });
+    let solution = pipeline::solve(mesh, features, options, &mut |p| bar.solve(p));
     bar.finish();
     solution.map_err(|e| Failure(format!("{file}: {e}"), 1))
 }

@@ -29,6 +29,13 @@ pub fn shared_mesh(name: &str) -> TriMesh {
     TriMesh::from_raw(&shared_raw(name)).unwrap_or_else(|p| panic!("{name}: {}", p[0]))
 }
 
+/// The committed fixture `tests/fixtures/NAME` (`cad/gear.obj`, say), imported and validated.
+pub fn fixture_mesh(name: &str) -> TriMesh {
+    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/fixtures")).join(name);
+    let raw = import_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    TriMesh::from_raw(&raw).unwrap_or_else(|p| panic!("{name}: {}", p[0]))
+}
+
 /// The shared meshes `names` side by side as one mesh, each moved clear of
 /// the ones before along x (a name may come again: copies).
 pub fn side_by_side(names: &[&str]) -> TriMesh {
