@@ -13,7 +13,7 @@
 //! found with a uniform grid over the primitives' bounding boxes, so the
 //! cost is about linear in the number of samples and primitives.
 
-use super::QuadMesh;
+use super::{QuadMesh, SurfacePoint};
 use crate::mesh::UnionFind;
 use crate::vec3::{add, angle, bounds, cross, dot, midpoint, norm, point_segment_distance, point_triangle_distance, scale, sub, V3};
 use crate::TriMesh;
@@ -413,20 +413,59 @@ fn corner_angles(quads: &QuadMesh, valid: &[bool]) -> AngleStats {
 }
 
 /// Quads (indices in range) whose Newell normal has a negative dot product
-/// with the sum of the input face normals at their corners' locations.
+/// with the sum of the input's normals at their corners: at a corner inside
+/// an input face, that face's normal; on an input edge or vertex (a crease,
+/// say), the normal of the face around it nearest the quad's centre, the
+/// face the quad lies on there (a quad across a strip narrower than a cell
+/// has its corners on the strip's creases, where the location's own face
+/// may be a neighbour's: 86 of a game asset's 3 784 quads were counted
+/// flipped that way).
 fn flipped_quads(input: &TriMesh, quads: &QuadMesh, valid: &[bool]) -> usize {
     let normals = input.face_normals();
+    let triangle = |f: u32| input.faces()[f as usize].map(|v| input.position(v));
     (0..quads.n_quads())
         .filter(|&q| valid[q])
         .filter(|&q| {
+            let points = quad_points(quads, q);
+            let centre = scale(add(add(points[0], points[1]), add(points[2], points[3])), 0.25);
             let reference = quads.quads[q]
                 .iter()
                 .filter_map(|&v| quads.locations.get(v as usize))
-                .filter_map(|l| normals.get(l.face as usize))
-                .fold([0.0; 3], |s, &n| add(s, n));
-            dot(newell_normal(&quad_points(quads, q)), reference) < 0.0
+                .filter(|l| (l.face as usize) < normals.len())
+                .map(|l| {
+                    let distance = |f: &u32| point_triangle_distance(centre, &triangle(*f));
+                    let nearest = faces_at(input, l).min_by(|a, b| distance(a).total_cmp(&distance(b)));
+                    normals[nearest.unwrap_or(l.face) as usize]
+                })
+                .fold([0.0; 3], add);
+            dot(newell_normal(&points), reference) < 0.0
         })
         .count()
+}
+
+/// Barycentric coordinate below which a surface point lies on the edge
+/// opposite that corner.
+const ON_EDGE: f64 = 1e-9;
+
+/// The input faces that hold surface point `l`: its face, and where it lies
+/// on an edge or at a vertex of it, the faces around that edge or vertex.
+fn faces_at<'a>(input: &'a TriMesh, l: &SurfacePoint) -> Box<dyn Iterator<Item = u32> + 'a> {
+    let corners = input.faces()[l.face as usize];
+    let off: Vec<usize> = (0..3).filter(|&i| l.bary[i] < ON_EDGE).collect();
+    match off.as_slice() {
+        // At the corner whose coordinate is not ~0.
+        [a, b] => Box::new(input.vertex_faces(corners[3 - a - b])),
+        // On the edge opposite corner `a`.
+        [a] => {
+            let h = input.face_halfedges(l.face).into_iter().find(|&h| input.tail(h) == corners[(a + 1) % 3] && input.head(h) == corners[(a + 2) % 3]);
+            let faces: Vec<u32> = match h {
+                Some(h) => [input.face(h), input.face(input.twin(h))].into_iter().flatten().collect(),
+                None => vec![l.face],
+            };
+            Box::new(faces.into_iter())
+        }
+        _ => Box::new(std::iter::once(l.face)),
+    }
 }
 
 /// `(quads → input, input → quads)`: the max distance from samples of the

@@ -147,6 +147,38 @@ fn a_reversed_quad_is_flipped_and_breaks_its_four_edges() {
     assert_eq!((r.non_manifold_vertices, r.degenerate_quads), (0, 0));
 }
 
+/// A slab whose top slopes up towards its end (`z` from 0 to `0.2 + 0.3 x`):
+/// the quad of its end face has its corners on the end's creases, each
+/// located in a top or bottom triangle, whose normals add up to point away
+/// from the end's. It is not flipped (each corner's admissible normals
+/// include the end face's); the same quad reversed is.
+#[test]
+fn a_quad_with_its_corners_on_creases_is_judged_by_the_faces_around_them() {
+    let mut quads = cube_quads(1);
+    for p in &mut quads.positions {
+        p[2] *= 0.2 + 0.3 * p[0];
+    }
+    let input = triangulate(&mut quads);
+    let end = (0..quads.n_quads()).find(|&q| quads.quads[q].iter().all(|&v| quads.positions[v as usize][0] == 1.0)).unwrap();
+    // Each end corner located in a triangle of the top (z > 0) or bottom side.
+    for &v in &quads.quads[end] {
+        let top = quads.positions[v as usize][2] > 0.0;
+        let side = (0..input.n_faces() as u32)
+            .find(|&f| {
+                let zs = input.faces()[f as usize].map(|c| input.position(c)[2]);
+                input.faces()[f as usize].contains(&v) && if top { zs.iter().all(|&z| z > 0.0) } else { zs.iter().all(|&z| z == 0.0) }
+            })
+            .unwrap();
+        let mut bary = [0.0; 3];
+        bary[input.faces()[side as usize].iter().position(|&c| c == v).unwrap()] = 1.0;
+        quads.locations[v as usize] = SurfacePoint { face: side, bary };
+    }
+    assert_eq!(check(&input, &quads).flipped_quads, 0);
+    let [a, b, c, d] = quads.quads[end];
+    quads.quads[end] = [a, d, c, b];
+    assert_eq!(check(&input, &quads).flipped_quads, 1);
+}
+
 #[test]
 fn a_vertex_pushed_off_the_surface_is_measured_both_ways() {
     let (n, d) = (4, 0.01);
