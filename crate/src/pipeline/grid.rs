@@ -1,4 +1,4 @@
-//! The integer-grid map of a solved map ([`param::quantize`]), solved again
+//! The integer-grid map of a solved map ([`crate::param::quantize`]), solved again
 //! on a finer mesh where the input's long edges leave the grid map folded.
 
 use super::{long_edges_refine, Solution, SolveOptions, SolveProgress};

@@ -434,7 +434,7 @@ fn flipped_quads(input: &TriMesh, quads: &QuadMesh, valid: &[bool]) -> usize {
                 .filter(|l| (l.face as usize) < normals.len())
                 .map(|l| {
                     let distance = |f: &u32| point_triangle_distance(centre, &triangle(*f));
-                    let nearest = faces_at(input, l).min_by(|a, b| distance(a).total_cmp(&distance(b)));
+                    let nearest = faces_at(input, l).into_iter().min_by(|a, b| distance(a).total_cmp(&distance(b)));
                     normals[nearest.unwrap_or(l.face) as usize]
                 })
                 .fold([0.0; 3], add);
@@ -449,22 +449,17 @@ const ON_EDGE: f64 = 1e-9;
 
 /// The input faces that hold surface point `l`: its face, and where it lies
 /// on an edge or at a vertex of it, the faces around that edge or vertex.
-fn faces_at<'a>(input: &'a TriMesh, l: &SurfacePoint) -> Box<dyn Iterator<Item = u32> + 'a> {
-    let corners = input.faces()[l.face as usize];
+fn faces_at(input: &TriMesh, l: &SurfacePoint) -> Vec<u32> {
     let off: Vec<usize> = (0..3).filter(|&i| l.bary[i] < ON_EDGE).collect();
     match off.as_slice() {
         // At the corner whose coordinate is not ~0.
-        [a, b] => Box::new(input.vertex_faces(corners[3 - a - b])),
-        // On the edge opposite corner `a`.
+        [a, b] => input.vertex_faces(input.faces()[l.face as usize][3 - a - b]).collect(),
+        // On the edge opposite corner `a`: face halfedge `a + 1` (corner `a + 1` → `a + 2`).
         [a] => {
-            let h = input.face_halfedges(l.face).into_iter().find(|&h| input.tail(h) == corners[(a + 1) % 3] && input.head(h) == corners[(a + 2) % 3]);
-            let faces: Vec<u32> = match h {
-                Some(h) => [input.face(h), input.face(input.twin(h))].into_iter().flatten().collect(),
-                None => vec![l.face],
-            };
-            Box::new(faces.into_iter())
+            let h = input.face_halfedges(l.face)[(a + 1) % 3];
+            [input.face(h), input.face(input.twin(h))].into_iter().flatten().collect()
         }
-        _ => Box::new(std::iter::once(l.face)),
+        _ => vec![l.face],
     }
 }
 
