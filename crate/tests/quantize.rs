@@ -278,6 +278,26 @@ fn spot_1000_quads_keep_their_integers() {
     assert_eq!(flipped, 0);
 }
 
+/// A scan much finer than its cells (bff-face, 34 k faces, at 1 000 quads:
+/// a cell spans about four edges): each rounded cone drags the uniform fit
+/// along as a spike, which folds its ring or winds the map around it (63
+/// wound vertices after the plain rounding). The polish's local stiffening
+/// spreads the spikes; without it, seven passes over 100 s still left six
+/// wound vertices.
+#[test]
+fn a_fine_scan_at_coarse_quads_is_stiffened_where_its_cones_spike() {
+    let input = load("bff-face.obj");
+    let features = FeatureSet::none(&input);
+    let options = SolveOptions::default().for_quads(&input, GridSize::Quads(1000));
+    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1000), &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert!(r.stiffening > 0, "the case this tests is gone: {r:?}");
+    assert_eq!((r.flipped, r.wound_vertices, r.conflicts), (0, 0, 0), "{r:?}");
+    assert!(r.integer_residual < 1e-9 && r.distortion_after < 1.5 * r.distortion_before, "{r:?}");
+    assert_eq!(check_integer_grid("bff-face", &solution.mesh, &features, &map.uv), (0, 0));
+}
+
 #[test]
 fn bunny_1000_quads() {
     assert_eq!(run("bff-bunny.obj", None, 1000), (0, 0));
@@ -350,9 +370,10 @@ fn stiffer_fit_around_cones_mends_coarse_grids() {
     assert!(r.angle_mean_deviation < 7.0, "fandisk: mean corner-angle deviation {}", r.angle_mean_deviation);
 }
 
-/// Where the map winds twice around a point with no flipped triangle
-/// (spot > 40° at 3 000 quads: two such vertices; fandisk > 60° at 1 000
-/// was the case until the held pass widened its rows), the extractor
+/// Where the map winds twice around a point with no flipped triangle (the
+/// cow at 1 500 quads; spot > 40° at 3 000 until the rounding's local
+/// stiffening, fandisk > 60° at 1 000 until the held pass widened its
+/// rows), the extractor
 /// closes the mesh instead of leaving holes: each cell traced around twice
 /// becomes quads around an input vertex, and the quad mesh is closed,
 /// manifold, one piece, with the input's Euler characteristic; the report
@@ -360,10 +381,10 @@ fn stiffer_fit_around_cones_mends_coarse_grids() {
 #[test]
 fn cells_the_map_winds_around_are_closed_with_quads() {
     use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
-    let input = load("spot.obj");
-    let features = FeatureSet::sharp_edges(&input, 40.0);
+    let input = load("cow.obj");
+    let features = FeatureSet::none(&input);
     let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
-    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1500), &mut |_, _| {}).unwrap();
     assert_eq!(map.report.flipped, 0, "{:?}", map.report);
     assert!(map.report.wound_vertices > 0, "the case this tests is gone: {:?}", map.report);
     let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
@@ -372,10 +393,11 @@ fn cells_the_map_winds_around_are_closed_with_quads() {
         assert!(d.what.contains("winds around") && !d.what.contains("skipped"), "{d:?}");
     }
     let r = check_quads(&solution.mesh, &quads, &CheckOptions::default());
-    assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (2, 0, 1), "{r:?}");
+    assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (solution.mesh.euler_characteristic(), 0, 1), "{r:?}");
     assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.unreferenced_vertices), (0, 0, 0), "{r:?}");
     assert_eq!(quads.uv.len(), 4 * quads.quads.len());
-    assert!(r.distance_input_to_quads_relative.unwrap() < 0.01, "{r:?}");
+    // Half the quads the 1 % target is set for (3 000): 1.1 % here.
+    assert!(r.distance_input_to_quads_relative.unwrap() < 0.015, "{r:?}");
 }
 
 /// The same quantizer serves a second grid size (the page re-runs only this

@@ -253,6 +253,8 @@ export interface QuantizeReport {
   /** Integers moved by one to undo a collapse. */
   moved_integers: number;
   arap_iterations: number;
+  /** Local stiffening iterations (MIQ's) the map kept was mended by (0: none). */
+  stiffening: number;
   /** Fit weight of the faces around singular points in the pass kept (1: the plain fit; more where that folded the map). */
   stiff_weight: number;
   /** The rounded map had flipped triangles and the untangler removed them all. */
@@ -336,7 +338,7 @@ export interface QuadsResult {
 
 export const QUANTIZE_REPORT_KEYS = {
   grid_size: true, point_forms: true, translation_forms: true, batches: true, separation_moves: true, separations: true,
-  separations_violated: true, separations_held: true, separations_widened: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiff_weight: true,
+  separations_violated: true, separations_held: true, separations_widened: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiffening: true, stiff_weight: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
   wound_vertices: true, cells: true, seconds: true,
 } as const satisfies Keys<QuantizeReport>;

@@ -229,6 +229,20 @@ const MIN_UNTANGLE_PATIENCE: usize = 3;
 /// ARAP iterations after the rounding, at most.
 const ARAP_ITERATIONS: usize = 20;
 
+/// Local stiffening re-solves of a rounded map that is bad, at most
+/// ([`Quantizer::stiffen`]), and the largest weight a face reaches.
+const STIFFEN_ITERATIONS: usize = 10;
+const MAX_STIFFENING: f64 = 1e6;
+
+/// Radius (grid cells) around the bad faces of a map within which
+/// [`Quantizer::stiffen`] raises the weights.
+const STIFFEN_CELLS: f64 = 1.0;
+
+/// Steps that relax a clean stiffened map's weights towards 1, at most,
+/// and the share of each weight's excess over 1 a step keeps.
+const RELAX_ITERATIONS: usize = 8;
+const RELAX_FACTOR: f64 = 0.5;
+
 /// How the grid size is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum GridSize {
@@ -327,6 +341,9 @@ pub struct QuantizeReport {
     pub moved_integers: usize,
     /// ARAP iterations kept after the rounding.
     pub arap_iterations: usize,
+    /// Local stiffening iterations the map kept was mended by (0: none;
+    /// the most of any part).
+    pub stiffening: usize,
     /// Fit weight of the faces around singular points in the pass kept (1:
     /// the plain fit; more where that folded or wound the map). On a mesh of
     /// several parts, that of the part with the largest map area (counts
@@ -554,7 +571,7 @@ impl Quantizer {
         } else {
             self.round_parts(s, retry, options, progress)?
         };
-        let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, untangled, stiff_weight, separations, separations_held, separations_widened, separations_violated, free_curve_ends, .. } = rounded;
+        let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, stiffening, untangled, stiff_weight, separations, separations_held, separations_widened, separations_violated, free_curve_ends, .. } = rounded;
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
             if let (FormKind::Cone | FormKind::Point, [(i, 1)], Some(v)) =
@@ -606,6 +623,7 @@ impl Quantizer {
             free_curve_ends,
             moved_integers,
             arap_iterations,
+            stiffening,
             stiff_weight,
             untangled,
             conflicts,
@@ -640,7 +658,11 @@ impl Quantizer {
         // separations mend collapses between parallel lines, and go first
         // where the plain fit leaves separations violated.
         let few = bad(&plain) && plain.collapsed + plain.wound <= STIFF_PASS_LIMIT;
-        let stiffer = few && stiff.contains(&true);
+        // Where only the polish mended the plain rounding (local
+        // stiffening), the stiffer fits may round to less distortion: tried
+        // on meshes with the full budgets.
+        let mended = plain.rounded_bad && !bad(&plain) && self.elements.len() as f64 <= FULL_BUDGET_FACES;
+        let stiffer = (few || mended) && stiff.contains(&true);
         let held_first = bad(&plain) && plain.separations_violated > 0;
         let mut best = None;
         keep_better(&mut best, plain, s);
@@ -648,7 +670,7 @@ impl Quantizer {
             self.held_passes(&plain_fit, &grid, &mut best, progress)?;
         }
         for &weight in STIFF_WEIGHTS.iter().skip(1).filter(|_| stiffer) {
-            if !is_bad(&best) {
+            if !is_bad(&best) && !mended {
                 break;
             }
             let rounded = self.round_and_polish(&Fit::new(&self.elements, &stiff, weight), &grid, Pass::default(), progress)?.expect("a stiff pass");
@@ -725,6 +747,7 @@ impl Quantizer {
             joined.separation_moves += r.separation_moves;
             joined.moved_integers += r.moved_integers;
             joined.arap_iterations = joined.arap_iterations.max(r.arap_iterations);
+            joined.stiffening = joined.stiffening.max(r.stiffening);
             joined.untangled |= r.untangled;
             joined.collapsed += r.collapsed;
             joined.separations += r.separations;
@@ -907,14 +930,15 @@ impl Quantizer {
         // The rounded map polished (untangled where it folds, then ARAP);
         // where it is still bad, the same after moving integers off collapses,
         // keeping whichever ends better.
+        let rounded_bad = self.badness(&x, s) > 0;
+        // The stiffer fits stiffen faces around singular points already.
+        let stiffen = fit.stiff_weight == 1.0;
         let mut moved_integers = 0;
-        let (mut arap_iterations, mut untangled) = (0, false);
+        let mut polish = Polished::default();
         if let Some(mut moved_system) = system {
-            let (polished, bad, iterations, untangle_ok) =
-                self.polish(x.clone(), &moved_system, targets, s)?;
-            let rounded = std::mem::replace(&mut x, polished);
-            (arap_iterations, untangled) = (iterations, untangle_ok);
-            if bad > 0 && UNCOLLAPSE_TRIALS > 0 {
+            polish = self.polish(x.clone(), &moved_system, targets, s, stiffen)?;
+            let rounded = std::mem::replace(&mut x, std::mem::take(&mut polish.x));
+            if polish.bad > 0 && UNCOLLAPSE_TRIALS > 0 {
                 let (mut moved_values, mut moved_x) = (values.clone(), rounded);
                 let moves = self.uncollapse(
                     &mut moved_values,
@@ -926,11 +950,10 @@ impl Quantizer {
                     separations,
                 )?;
                 if moves > 0 {
-                    let (polished, moved_bad, iterations, untangle_ok) =
-                        self.polish(moved_x, &moved_system, targets, s)?;
-                    if moved_bad < bad {
-                        (x, arap_iterations, untangled, values, moved_integers) =
-                            (polished, iterations, untangle_ok, moved_values, moves);
+                    let mut moved = self.polish(moved_x, &moved_system, targets, s, stiffen)?;
+                    if moved.bad < polish.bad {
+                        (x, values, moved_integers) = (std::mem::take(&mut moved.x), moved_values, moves);
+                        polish = moved;
                     }
                 }
             }
@@ -942,8 +965,9 @@ impl Quantizer {
             batches,
             separation_moves,
             moved_integers,
-            arap_iterations,
-            untangled,
+            arap_iterations: polish.arap_iterations,
+            untangled: polish.untangled,
+            stiffening: polish.stiffening,
             collapsed,
             wound,
             distortion,
@@ -952,6 +976,7 @@ impl Quantizer {
             separations_held: held.list.len(),
             separations_widened: held.gaps.iter().filter(|&&g| g > 1).count(),
             held_dropped,
+            rounded_bad,
             pass,
             separations_violated,
             free_curve_ends: self.curve_ends.iter().filter(|end| end.free_at(s)).count(),
@@ -1189,18 +1214,24 @@ impl Quantizer {
         }
     }
 
-    /// Untangles `x` under `system`'s rows when it folds, then runs ARAP
-    /// local/global iterations (eq. 4), each step kept unless it makes the
-    /// map worse by [`Self::badness`]. Returns the map, its badness, the ARAP
-    /// iterations kept and whether the untangling left no fold.
+    /// Where `x` is bad and with `stiffen`, starts from its least bad local
+    /// stiffening ([`Self::stiffen`]); untangles it under `system`'s rows when it
+    /// folds, then runs ARAP local/global iterations (eq. 4) with `system`'s
+    /// fit weights, each step kept
+    /// unless it makes the map worse by [`Self::badness`].
     fn polish(
         &self,
         mut x: Vec<f64>,
         system: &RoundedSystem,
         targets: &[[[f64; 2]; 2]],
         s: f64,
-    ) -> Result<(Vec<f64>, usize, usize, bool), QuantizeError> {
+        stiffen: bool,
+    ) -> Result<Polished, QuantizeError> {
         let mut bad = self.badness(&x, s);
+        let mut stiffening = 0;
+        if bad > 0 && stiffen {
+            (x, bad, stiffening) = self.stiffen(x, bad, system, targets, s)?;
+        }
         let mut arap_iterations = 0;
         let mut untangled = false;
         // The untangler mends inverted triangles; a map whose only fault is a
@@ -1254,7 +1285,83 @@ impl Quantizer {
                 break;
             }
         }
-        Ok((x, bad, arap_iterations, untangled))
+        Ok(Polished { x, bad, arap_iterations, untangled, stiffening })
+    }
+
+    /// The local stiffening of Bommes et al. 2009 (MIQ) of the rounded map
+    /// `x` (badness `bad`) under `system`'s rows: the fit weight of every
+    /// face within [`STIFFEN_CELLS`] of a bad one ([`Self::flipped_faces`])
+    /// is multiplied by `1 + e_f`, `e_f` its relative Jacobian error
+    /// `|J_f - T_f| / |T_f|` plus one where it is collapsed, and the map
+    /// solved again, at most [`STIFFEN_ITERATIONS`] times while it is bad.
+    /// A rounded point drags the uniform fit along as a spike (the
+    /// displacement of a point constraint decays within a ring), which
+    /// folds its ring or winds the map around it; the weights grow fastest
+    /// where the spike is sharpest and spread it until the ring moves with
+    /// its point; a clean map's weights then relax towards 1 while it stays
+    /// clean. Returns the least bad map, its badness and the iterations
+    /// that led to it (0: none made the map less bad). One symbolic
+    /// analysis, one numeric factorization per iteration; each solve is put
+    /// back onto the rows by `system` (heavy weights leave it off them by
+    /// up to 1e-9), and one the weights make fail ends the iterations.
+    fn stiffen(
+        &self,
+        mut x: Vec<f64>,
+        mut bad: usize,
+        system: &RoundedSystem,
+        targets: &[[[f64; 2]; 2]],
+        s: f64,
+    ) -> Result<(Vec<f64>, usize, usize), QuantizeError> {
+        let mut weights = system.weights.clone();
+        let mut best_weights: Option<(Vec<f64>, usize)> = None;
+        let mut kkt = Kkt::assemble(&stiffness_triplets(&self.elements, &weights), self.n_unknowns, &system.c, system.b.len())?;
+        let mut solver: Option<LdltSolver> = None;
+        let mut current = x.clone();
+        let rings = self.rings(STIFFEN_CELLS, s);
+        for iteration in 1..=STIFFEN_ITERATIONS {
+            let near = local::faces_around(&self.faces, &self.flipped_faces(&current, s), rings);
+            for (f, (el, t)) in self.elements.iter().zip(targets).enumerate().filter(|&(f, _)| near[f]) {
+                let j = el.jacobian(&current);
+                let norm = |m: [[f64; 2]; 2]| m.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+                let error = norm([[j[0][0] - t[0][0], j[0][1] - t[0][1]], [j[1][0] - t[1][0], j[1][1] - t[1][1]]]) / norm(*t).max(f64::MIN_POSITIVE);
+                let collapsed = if self.collapsed(f, &current, s) { 1.0 } else { 0.0 };
+                weights[f] = (weights[f] * (1.0 + error + collapsed)).min(MAX_STIFFENING);
+            }
+            kkt.refill(&stiffness_triplets(&self.elements, &weights), &system.c)?;
+            // A solve the heavy weights make fail ends the stiffening.
+            let solved = match solver.as_mut() {
+                Some(solver) => solver.factorize(&kkt.values).map(|()| &*solver),
+                None => factored(&kkt).map(|factor| &*solver.insert(factor)),
+            }
+            .map_err(QuantizeError::from)
+            .and_then(|solver| fit_solve(solver, self, &weights, targets, &system.b));
+            let Ok(solved) = solved else { break };
+            current = system.onto_constraints(solved)?;
+            let next = self.badness(&current, s);
+            if next < bad {
+                (x, bad, best_weights) = (current.clone(), next, Some((weights.clone(), iteration)));
+            }
+            if bad == 0 {
+                break;
+            }
+        }
+        let (Some((best, iterations)), Some(mut solver)) = (best_weights, solver) else { return Ok((x, bad, 0)) };
+        // A clean map's weights relax towards 1 while it stays clean (the
+        // least distortion that does not fold).
+        if bad == 0 {
+            for step in 1..=RELAX_ITERATIONS {
+                let keep = RELAX_FACTOR.powi(step as i32);
+                weights = best.iter().map(|w| 1.0 + (w - 1.0) * keep).collect();
+                kkt.refill(&stiffness_triplets(&self.elements, &weights), &system.c)?;
+                let Ok(relaxed) = solver.factorize(&kkt.values).map_err(QuantizeError::from).and_then(|()| fit_solve(&solver, self, &weights, targets, &system.b)) else { break };
+                let relaxed = system.onto_constraints(relaxed)?;
+                if self.badness(&relaxed, s) > 0 {
+                    break;
+                }
+                x = relaxed;
+            }
+        }
+        Ok((x, bad, iterations))
     }
 
     /// Where the rounded map has flipped or collapsed triangles or wound
@@ -1350,17 +1457,13 @@ impl Quantizer {
         if self.elements.len() as f64 <= FULL_BUDGET_FACES {
             return Ok(None);
         }
-        // Rings of faces that span a radius: the edge of an equilateral
-        // triangle of the mean area.
-        let mean_area = self.seamless_areas.iter().sum::<f64>() / self.seamless_areas.len().max(1) as f64;
-        let edge = (mean_area * 4.0 / 3f64.sqrt()).sqrt().max(f64::MIN_POSITIVE);
         let mut done: Option<UntangleStats> = None;
         for cells in PATCH_CELLS {
             let seeds = local::inverted_faces(&self.elements, xm);
             if seeds.is_empty() {
                 break;
             }
-            let rings = (cells * s / edge).ceil().clamp(1.0, MAX_PATCH_RINGS as f64) as usize;
+            let rings = self.rings(cells, s);
             let in_patch = local::faces_around(&self.faces, &seeds, rings);
             if in_patch.iter().filter(|&&inside| inside).count() as f64 > MAX_PATCH_SHARE * self.faces.len() as f64 {
                 return Ok(None);
@@ -1375,6 +1478,15 @@ impl Quantizer {
             });
         }
         Ok(done)
+    }
+
+    /// Vertex rings of faces that span `cells` grid cells of length `s` (in
+    /// the edge of an equilateral triangle of the mean seamless area; at
+    /// least one, at most [`MAX_PATCH_RINGS`]).
+    fn rings(&self, cells: f64, s: f64) -> usize {
+        let mean_area = self.seamless_areas.iter().sum::<f64>() / self.seamless_areas.len().max(1) as f64;
+        let edge = (mean_area * 4.0 / 3f64.sqrt()).sqrt().max(f64::MIN_POSITIVE);
+        (cells * s / edge).ceil().clamp(1.0, MAX_PATCH_RINGS as f64) as usize
     }
 
     /// Whether face `f` of `x` (grid size `s`) is flipped or collapsed: its
@@ -1582,6 +1694,18 @@ impl Fit {
     }
 }
 
+/// What [`Quantizer::polish`] made of a rounded map: the map, its
+/// [`Quantizer::badness`], the ARAP iterations kept, whether the untangler
+/// left no fold, and the local stiffening iterations it started from.
+#[derive(Default)]
+struct Polished {
+    x: Vec<f64>,
+    bad: usize,
+    arap_iterations: usize,
+    untangled: bool,
+    stiffening: usize,
+}
+
 /// The outcome of one [`Quantizer::round_and_polish`].
 #[derive(Default)]
 struct Rounded {
@@ -1607,6 +1731,10 @@ struct Rounded {
     /// Held pairs the relaxed map left violated (their rows dependent on
     /// the others) before any widening.
     held_dropped: usize,
+    /// Local stiffening iterations the polish started from ([`Quantizer::stiffen`]).
+    stiffening: usize,
+    /// Whether the rounded map was bad before its polish.
+    rounded_bad: bool,
     pass: Pass,
     /// Ends of feature curves left off the grid points at its grid size.
     free_curve_ends: usize,
@@ -1721,24 +1849,31 @@ impl RoundedSystem {
 
     /// The map closest to per-face target Jacobians `targets` under this system's rows.
     fn resolve(&self, q: &Quantizer, targets: &[[[f64; 2]; 2]]) -> Result<Vec<f64>, QuantizeError> {
-        let mut rhs = vec![0.0; q.n_unknowns];
-        for ((el, t), w) in q.elements.iter().zip(targets).zip(&self.weights) {
-            for k in 0..3 {
-                let g = el.g[k];
-                for c in 0..2 {
-                    rhs[el.x[c][k]] += w * el.area * (g[0] * t[c][0] + g[1] * t[c][1]);
-                }
+        fit_solve(&self.solver, q, &self.weights, targets, &self.b)
+    }
+}
+
+/// The map closest to per-face target Jacobians `targets` with face weights
+/// `weights`, under the rows of `solver` (a factored KKT of that fit) with
+/// values `b`.
+fn fit_solve(solver: &LdltSolver, q: &Quantizer, weights: &[f64], targets: &[[[f64; 2]; 2]], b: &[f64]) -> Result<Vec<f64>, QuantizeError> {
+    let mut rhs = vec![0.0; q.n_unknowns];
+    for ((el, t), w) in q.elements.iter().zip(targets).zip(weights) {
+        for k in 0..3 {
+            let g = el.g[k];
+            for c in 0..2 {
+                rhs[el.x[c][k]] += w * el.area * (g[0] * t[c][0] + g[1] * t[c][1]);
             }
         }
-        rhs.extend_from_slice(&self.b);
-        let x = self.solver.solve_many_to(&rhs, 1, SOLVE_TOLERANCE)?.0;
-        if x.iter().any(|v| !v.is_finite()) {
-            return Err(QuantizeError::Param(ParamError::NotFinite {
-                what: "quantized map",
-            }));
-        }
-        Ok(x[..q.n_unknowns].to_vec())
     }
+    rhs.extend_from_slice(b);
+    let x = solver.solve_many_to(&rhs, 1, SOLVE_TOLERANCE)?.0;
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(QuantizeError::Param(ParamError::NotFinite {
+            what: "quantized map",
+        }));
+    }
+    Ok(x[..q.n_unknowns].to_vec())
 }
 
 /// `q <- Z (Zᵀ A Z)⁻¹ Zᵀ q` (the untangler's preconditioner): the solve
