@@ -1317,7 +1317,7 @@ impl Quantizer {
     /// that led to it (0: none made the map less bad). One symbolic
     /// analysis, one numeric factorization per iteration; each solve is put
     /// back onto the rows by `system` (heavy weights leave it off them by
-    /// up to 1e-9), and one the weights make fail ends the iterations.
+    /// up to 1e-9), and one that fails ends the iterations.
     fn stiffen(
         &self,
         mut x: Vec<f64>,
@@ -1348,9 +1348,10 @@ impl Quantizer {
                 None => factored(&kkt).map(|factor| &*solver.insert(factor)),
             }
             .map_err(QuantizeError::from)
-            .and_then(|solver| fit_solve(solver, self, &weights, targets, &system.b));
+            .and_then(|solver| fit_solve(solver, self, &weights, targets, &system.b))
+            .and_then(|solved| system.onto_constraints(solved));
             let Ok(solved) = solved else { break };
-            current = system.onto_constraints(solved)?;
+            current = solved;
             let next = self.badness(&current, s);
             if next < bad {
                 (x, bad, best_weights) = (current.clone(), next, Some((weights.clone(), iteration)));
@@ -1368,8 +1369,12 @@ impl Quantizer {
                 let keep = RELAX_FACTOR.powi(step as i32);
                 weights = best.iter().map(|w| 1.0 + (w - 1.0) * keep).collect();
                 kkt.refill(&stiffness_triplets(&self.elements, &weights), &system.c)?;
-                let Ok(relaxed) = solver.factorize(&kkt.values).map_err(QuantizeError::from).and_then(|()| fit_solve(&solver, self, &weights, targets, &system.b)) else { break };
-                let relaxed = system.onto_constraints(relaxed)?;
+                let relaxed = solver
+                    .factorize(&kkt.values)
+                    .map_err(QuantizeError::from)
+                    .and_then(|()| fit_solve(&solver, self, &weights, targets, &system.b))
+                    .and_then(|relaxed| system.onto_constraints(relaxed));
+                let Ok(relaxed) = relaxed else { break };
                 if self.badness(&relaxed, s) > 0 {
                     break;
                 }
