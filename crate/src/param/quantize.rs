@@ -945,13 +945,14 @@ impl Quantizer {
         // The rounded map polished (untangled where it folds, then ARAP);
         // where it is still bad, the same after moving integers off collapses,
         // keeping whichever ends better.
-        let rounded_bad = self.badness(&x, s) > 0;
         // The stiffer fits stiffen faces around singular points already.
         let stiffen = fit.stiff_weight == 1.0;
         let mut moved_integers = 0;
         let mut polish = Polished::default();
+        let mut rounded_bad = false;
         if let Some(mut moved_system) = system {
             polish = self.polish(x.clone(), &moved_system, targets, s, stiffen)?;
+            rounded_bad = polish.rounded_bad > 0;
             let rounded = std::mem::replace(&mut x, std::mem::take(&mut polish.x));
             if polish.bad > 0 && UNCOLLAPSE_TRIALS > 0 {
                 let (mut moved_values, mut moved_x) = (values.clone(), rounded);
@@ -1241,7 +1242,8 @@ impl Quantizer {
         s: f64,
         stiffen: bool,
     ) -> Result<Polished, QuantizeError> {
-        let mut bad = self.badness(&x, s);
+        let rounded_bad = self.badness(&x, s);
+        let mut bad = rounded_bad;
         let mut stiffening = 0;
         if bad > 0 && stiffen {
             (x, bad, stiffening) = self.stiffen(x, bad, system, targets, s)?;
@@ -1299,7 +1301,7 @@ impl Quantizer {
                 break;
             }
         }
-        Ok(Polished { x, bad, arap_iterations, untangled, stiffening })
+        Ok(Polished { x, bad, rounded_bad, arap_iterations, untangled, stiffening })
     }
 
     /// The local stiffening of Bommes et al. 2009 (MIQ) of the rounded map
@@ -1341,16 +1343,8 @@ impl Quantizer {
                 let collapsed = if self.collapsed(f, &current, s) { 1.0 } else { 0.0 };
                 weights[f] = (weights[f] * (1.0 + error + collapsed)).min(MAX_STIFFENING);
             }
-            kkt.refill(&stiffness_triplets(&self.elements, &weights), &system.c)?;
             // A solve the heavy weights make fail ends the stiffening.
-            let solved = match solver.as_mut() {
-                Some(solver) => solver.factorize(&kkt.values).map(|()| &*solver),
-                None => factored(&kkt).map(|factor| &*solver.insert(factor)),
-            }
-            .map_err(QuantizeError::from)
-            .and_then(|solver| fit_solve(solver, self, &weights, targets, &system.b))
-            .and_then(|solved| system.onto_constraints(solved));
-            let Ok(solved) = solved else { break };
+            let Ok(solved) = self.weighted_solve(&mut kkt, &mut solver, &weights, system, targets) else { break };
             current = solved;
             let next = self.badness(&current, s);
             if next < bad {
@@ -1361,20 +1355,14 @@ impl Quantizer {
                 break;
             }
         }
-        let (Some((best, iterations)), Some(mut solver)) = (best_weights, solver) else { return Ok((x, bad, 0)) };
+        let Some((best, iterations)) = best_weights else { return Ok((x, bad, 0)) };
         // A clean map's weights relax towards 1 while it stays clean (the
         // least distortion that does not fold).
         if bad == 0 {
             for step in 1..=RELAX_ITERATIONS {
                 let keep = RELAX_FACTOR.powi(step as i32);
                 weights = best.iter().map(|w| 1.0 + (w - 1.0) * keep).collect();
-                kkt.refill(&stiffness_triplets(&self.elements, &weights), &system.c)?;
-                let relaxed = solver
-                    .factorize(&kkt.values)
-                    .map_err(QuantizeError::from)
-                    .and_then(|()| fit_solve(&solver, self, &weights, targets, &system.b))
-                    .and_then(|relaxed| system.onto_constraints(relaxed));
-                let Ok(relaxed) = relaxed else { break };
+                let Ok(relaxed) = self.weighted_solve(&mut kkt, &mut solver, &weights, system, targets) else { break };
                 if self.badness(&relaxed, s) > 0 {
                     break;
                 }
@@ -1382,6 +1370,29 @@ impl Quantizer {
             }
         }
         Ok((x, bad, iterations))
+    }
+
+    /// The map closest to `targets` with fit weights `weights` under
+    /// `system`'s rows, put back onto them by `system`: `kkt` (assembled on
+    /// `system`'s rows) refilled and factored by `solver`, whose symbolic
+    /// analysis is made on first use and kept.
+    fn weighted_solve(
+        &self,
+        kkt: &mut Kkt,
+        solver: &mut Option<LdltSolver>,
+        weights: &[f64],
+        system: &RoundedSystem,
+        targets: &[[[f64; 2]; 2]],
+    ) -> Result<Vec<f64>, QuantizeError> {
+        kkt.refill(&stiffness_triplets(&self.elements, weights), &system.c)?;
+        let solver = match solver {
+            Some(solver) => {
+                solver.factorize(&kkt.values)?;
+                solver
+            }
+            None => solver.insert(factored(kkt)?),
+        };
+        system.onto_constraints(fit_solve(solver, self, weights, targets, &system.b)?)
     }
 
     /// Where the rounded map has flipped or collapsed triangles or wound
@@ -1715,12 +1726,14 @@ impl Fit {
 }
 
 /// What [`Quantizer::polish`] made of a rounded map: the map, its
-/// [`Quantizer::badness`], the ARAP iterations kept, whether the untangler
-/// left no fold, and the local stiffening iterations it started from.
+/// [`Quantizer::badness`] and that of the map it was given, the ARAP
+/// iterations kept, whether the untangler left no fold, and the local
+/// stiffening iterations it started from.
 #[derive(Default)]
 struct Polished {
     x: Vec<f64>,
     bad: usize,
+    rounded_bad: usize,
     arap_iterations: usize,
     untangled: bool,
     stiffening: usize,
