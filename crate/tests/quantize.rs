@@ -298,6 +298,26 @@ fn a_fine_scan_at_coarse_quads_is_stiffened_where_its_cones_spike() {
     assert_eq!(check_integer_grid("bff-face", &solution.mesh, &features, &map.uv), (0, 0));
 }
 
+/// Spot subdivided twice (93 k faces, a cell spanning about six edges) at
+/// 1 300 quads: the plain fit's rounded points drag their rings along as
+/// spikes that wind the map around them, which its local stiffening does
+/// not mend; the graded fit keeps them flat and the map is clean.
+#[test]
+fn a_mesh_much_finer_than_its_cells_is_rounded_with_the_graded_fit() {
+    use conemap::mesh::subdivide_midpoint;
+    let raw = subdivide_midpoint(&subdivide_midpoint(&common::shared_raw("spot.obj")));
+    let input = TriMesh::from_raw(&raw).unwrap();
+    let features = FeatureSet::none(&input);
+    let options = SolveOptions::default().for_quads(&input, GridSize::Quads(1300));
+    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1300), &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert!(r.graded_fit, "the case this tests is gone: {r:?}");
+    assert_eq!((r.flipped, r.wound_vertices, r.conflicts), (0, 0, 0), "{r:?}");
+    assert!(r.integer_residual < 1e-9 && r.distortion_after < 1.8 * r.distortion_before, "{r:?}");
+    assert_eq!(check_integer_grid("spot x16", &solution.mesh, &features, &map.uv), (0, 0));
+}
+
 #[test]
 fn bunny_1000_quads() {
     assert_eq!(run("bff-bunny.obj", None, 1000), (0, 0));

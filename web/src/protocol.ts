@@ -257,6 +257,8 @@ export interface QuantizeReport {
   stiffening: number;
   /** Fit weight of the faces around singular points in the pass kept (1: the plain fit; more where that folded the map). */
   stiff_weight: number;
+  /** The pass kept weighs faces near singular points by 1 + (rho / r)^2 (the graded fit, tried where the plain fit's map was bad). */
+  graded_fit: boolean;
   /** The rounded map had flipped triangles and the untangler removed them all. */
   untangled: boolean;
   /** Forms left at a non-integer value (0 on success). */
@@ -338,7 +340,7 @@ export interface QuadsResult {
 
 export const QUANTIZE_REPORT_KEYS = {
   grid_size: true, point_forms: true, translation_forms: true, batches: true, separation_moves: true, separations: true,
-  separations_violated: true, separations_held: true, separations_widened: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiffening: true, stiff_weight: true,
+  separations_violated: true, separations_held: true, separations_widened: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiffening: true, stiff_weight: true, graded_fit: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
   wound_vertices: true, cells: true, seconds: true,
 } as const satisfies Keys<QuantizeReport>;
