@@ -11,6 +11,8 @@
 //   native:quads / wasm-node:quads: integer-grid quantization and quad extraction
 //   on fandisk (sharp > 60°) and spot at about 1 000, 3 000 and 10 000 quads
 //   (scripts/lib/bench-quads.mjs), with QuadriFlow's figures as static rows
+//   native:quads-scaling: the same on spot subdivided 0-2 times (0-3 with --big):
+//   one surface, finer meshes; the growth exponent at each quad count
 //
 // Each entry of BENCHES is { env, stage, run(ctx) } and returns rows
 // { input, faces?, ms, runs?, note? } (env/stage are filled in). Later pipeline
@@ -25,7 +27,7 @@ import { createRequire } from 'node:module';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { nativeQuadRows, quadMeshes, wasmNodeQuadRows } from './lib/bench-quads.mjs';
+import { QUAD_TARGETS, nativeQuadRows, quadMeshes, wasmNodeQuadRows } from './lib/bench-quads.mjs';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const args = new Set(process.argv.slice(2));
@@ -391,6 +393,32 @@ function nativeQuads(ctx) {
   return nativeQuadRows(bin, quadMeshes(ctx.inputs[0].file, sharedMeshes));
 }
 
+/**
+ * Quantization and extraction against mesh size: spot subdivided 0-2 times
+ * (0-3 with --big), the same surface at 4x the faces each time, at about
+ * 1 000, 3 000 and 10 000 quads (the rows of `nativeQuadRows`), and the
+ * exponent e of (quantize + extract) time ∝ faces^e at each quad count.
+ */
+function nativeQuadScaling() {
+  const spot = path.join(sharedMeshes, 'spot.obj');
+  if (!fs.existsSync(spot)) return { skipped: `${spot} not found` };
+  const bin = releaseCli();
+  if (bin.skipped) return bin;
+  const meshes = [];
+  for (let levels = 0; levels <= (args.has('--big') ? 3 : 2); levels++) {
+    const { file } = levels ? subObj(spot, levels) : { file: spot };
+    meshes.push({ name: path.basename(file), file, sharp: null, label: `spot.obj ×4^${levels} (no features)` });
+  }
+  const all = nativeQuadRows(bin, meshes);
+  if (!Array.isArray(all)) return all;
+  const rows = all.filter((r) => !r.static);
+  for (const n of QUAD_TARGETS) {
+    const at = rows.filter((r) => r.target === n);
+    rows.push(growthRow(`spot.obj family, N = ${n.toLocaleString('en-US')}`, at.map((r) => [Math.log(r.faces), Math.log(r.ms)])));
+  }
+  return rows;
+}
+
 /** The same in wasm under node: one `MeshSession.solve` per mesh, then `session.quads(n)` per N (wall clock). */
 function wasmNodeQuads(ctx) {
   const pkg = path.join(root, 'build/pkg-node/conemap.js');
@@ -751,6 +779,7 @@ const BENCHES = [
   { env: 'native', stage: 'free-boundary', run: nativeFreeBoundary, enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'solve', run: wasmNodeSolve, enabled: true },
   { env: 'native', stage: 'quads', run: nativeQuads, enabled: !args.has('--no-native') },
+  { env: 'native', stage: 'quads-scaling', run: nativeQuadScaling, enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'quads', run: wasmNodeQuads, enabled: true },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },
