@@ -723,8 +723,10 @@ impl Quantizer {
     /// bad in at most [`STIFF_PASS_LIMIT`] places; the held passes (if not
     /// run yet) where it is; then, with `retry` (a quad count asked, not a
     /// length), nearby grid lengths ([`RETRY_GRID_FACTORS`]), holding the
-    /// separations where the best map so far is the held pass's. Returns
-    /// the map kept and its grid length.
+    /// separations where the best map so far is the held pass's. The graded
+    /// fit ([`Self::graded_fit`]) runs right after a bad plain pass on a
+    /// large mesh whose cells span [`GRADED_FIRST_RINGS`] edge rings or
+    /// more, else after all of them. Returns the map kept and its grid length.
     fn round(&self, s: f64, retry: bool, options: &QuantizeOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<(Rounded, f64), QuantizeError> {
         let grid = self.grid_start(s);
         let stiff = self.stiff_faces(&grid.x0);
