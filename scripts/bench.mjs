@@ -302,18 +302,32 @@ function nativeFreeBoundary() {
 }
 
 /**
- * Growth with mesh size: spot subdivided 0-2 times (0-3 with --big), α = 0.01;
- * a row per size and the fitted exponent e of time ∝ faces^e.
+ * spot.obj and its midpoint subdivisions, 1-2 times (1-3 with --big): the
+ * same surface at 4x the faces each time, as [{ levels, file }], or
+ * `{ skipped }` where the shared meshes are absent.
  */
-function nativeScaling() {
+function spotFamily() {
   const spot = path.join(sharedMeshes, 'spot.obj');
   if (!fs.existsSync(spot)) return { skipped: `${spot} not found` };
+  const family = [];
+  for (let levels = 0; levels <= (args.has('--big') ? 3 : 2); levels++) {
+    family.push({ levels, file: levels ? subObj(spot, levels).file : spot });
+  }
+  return family;
+}
+
+/**
+ * Growth with mesh size: the spot family (`spotFamily`), α = 0.01; a row
+ * per size and the fitted exponent e of time ∝ faces^e.
+ */
+function nativeScaling() {
+  const family = spotFamily();
+  if (family.skipped) return family;
   const bin = releaseCli();
   if (bin.skipped) return bin;
   const rows = [];
   const points = [];
-  for (let levels = 0; levels <= (args.has('--big') ? 3 : 2); levels++) {
-    const { file } = levels ? subObj(spot, levels) : { file: spot };
+  for (const { levels, file } of family) {
     const j = solveReport(bin, file);
     if (j.skipped) return j;
     rows.push(solveRow('file → UVs', `spot.obj ×4^${levels}`, j));
@@ -394,21 +408,17 @@ function nativeQuads(ctx) {
 }
 
 /**
- * Quantization and extraction against mesh size: spot subdivided 0-2 times
- * (0-3 with --big), the same surface at 4x the faces each time, at about
- * 1 000, 3 000 and 10 000 quads (the rows of `nativeQuadRows`), and the
- * exponent e of (quantize + extract) time ∝ faces^e at each quad count.
+ * Quantization and extraction against mesh size: the spot family
+ * (`spotFamily`) at about 1 000, 3 000 and 10 000 quads (the rows of
+ * `nativeQuadRows`), and the exponent e of (quantize + extract) time ∝
+ * faces^e at each quad count.
  */
 function nativeQuadScaling() {
-  const spot = path.join(sharedMeshes, 'spot.obj');
-  if (!fs.existsSync(spot)) return { skipped: `${spot} not found` };
+  const family = spotFamily();
+  if (family.skipped) return family;
   const bin = releaseCli();
   if (bin.skipped) return bin;
-  const meshes = [];
-  for (let levels = 0; levels <= (args.has('--big') ? 3 : 2); levels++) {
-    const { file } = levels ? subObj(spot, levels) : { file: spot };
-    meshes.push({ name: path.basename(file), file, sharp: null, label: `spot.obj ×4^${levels} (no features)` });
-  }
+  const meshes = family.map(({ levels, file }) => ({ name: path.basename(file), file, sharp: null, label: `spot.obj ×4^${levels} (no features)` }));
   const all = nativeQuadRows(bin, meshes);
   if (!Array.isArray(all)) return all;
   const rows = all.filter((r) => !r.static);
