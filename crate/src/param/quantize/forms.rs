@@ -13,6 +13,10 @@ use crate::param::seamless::{curve_rotation, curve_wedge_pairs, RowSet};
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_4, PI};
 
+/// Feature curves shorter than this many grid cells keep their inner ends
+/// off the grid points ([`CurveEnd`]).
+pub(super) const CURVE_END_CELLS: f64 = 1.0;
+
 /// What an integer form pins down.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 pub(super) enum FormKind {
@@ -39,7 +43,7 @@ impl CurveEnd {
     /// Whether the end is left free at grid size `s`.
     #[inline]
     pub(super) fn free_at(&self, s: f64) -> bool {
-        self.length < super::CURVE_END_CELLS * s
+        self.length < CURVE_END_CELLS * s
     }
 }
 

@@ -11,8 +11,9 @@
 //! untangles the whole map instead ([`super::Quantizer::untangle_locally`]).
 
 use super::super::element::{signed_uv_area, Element};
+use super::super::seamless::stiffness_triplets;
 use super::super::untangle::{untangle, UntangleOptions, UntangleStats};
-use super::factored;
+use super::fit::{factored, precondition};
 use crate::linalg::{independent_rows, Kkt, LdltSolver, LinalgError, NullSpaceProjector, Triplet};
 
 /// The unknowns of a patch of faces (free), the unknowns of its faces'
@@ -116,7 +117,7 @@ impl Patch {
             c_local.extend(row.iter().map(|&(u, a)| (n_rows, u, a as f64)));
             n_rows += 1;
         }
-        let stiffness: Vec<Triplet> = super::stiffness_triplets(&patch_elements, &vec![1.0; patch_elements.len()])
+        let stiffness: Vec<Triplet> = stiffness_triplets(&patch_elements, &vec![1.0; patch_elements.len()])
             .into_iter()
             .filter(|&(i, j, _)| i < n_free && j < n_free)
             .collect();
@@ -132,7 +133,7 @@ impl Patch {
         // Held unknowns do not move.
         let precondition = |q: &mut [f64]| {
             let (free, held) = q.split_at_mut(self.n_free);
-            super::precondition(&self.solver, self.n_rows, free, self.projector.as_ref());
+            precondition(&self.solver, self.n_rows, free, self.projector.as_ref());
             held.iter_mut().for_each(|v| *v = 0.0);
         };
         let stats = untangle(&self.elements, &precondition, &mut xl, options);
