@@ -224,9 +224,10 @@ fn forms_determined_at_half_integers_are_made_integers() {
 /// rounded again at nearby grid sizes and the map with fewer faults kept.
 /// The cow at 3 000 cells wound around 2 vertices at the asked length and
 /// none at 0.97 of it until the held pass widened its rows; it is now clean
-/// at the asked length. At 1 500 cells it winds around 2 vertices at all
-/// three lengths: the map kept is no worse than the plain one and still an
-/// integer-grid map away from those vertices.
+/// at the asked length. At 1 000 cells it winds around 4 vertices at the
+/// asked length (at 1 500 cells, 2 at all three lengths, until tube periods
+/// were kept three steps around): the map kept is no worse than the plain
+/// one and still an integer-grid map away from those vertices.
 #[test]
 fn uv_grid_maps_round_again_where_they_wind_around_vertices() {
     let cow = load("cow.obj");
@@ -235,10 +236,10 @@ fn uv_grid_maps_round_again_where_they_wind_around_vertices() {
     let quantizer = solution.quantizer().unwrap();
     let clean = quantizer.quantize(&solution.mesh, GridSize::Quads(3000), &mut |_, _| {}).unwrap();
     assert_eq!((clean.report.flipped, clean.report.wound_vertices), (0, 0), "{:?}", clean.report);
-    let plain = quantizer.quantize(&solution.mesh, GridSize::Quads(1500), &mut |_, _| {}).unwrap();
+    let plain = quantizer.quantize(&solution.mesh, GridSize::Quads(1000), &mut |_, _| {}).unwrap();
     assert!(plain.report.flipped == 0 && plain.report.wound_vertices > 0, "the case this test is about: {:?}", plain.report);
     let options = QuantizeOptions { retry_wound: true };
-    let map = quantizer.quantize_with(&solution.mesh, GridSize::Quads(1500), &options, &mut |_, _| {}).unwrap();
+    let map = quantizer.quantize_with(&solution.mesh, GridSize::Quads(1000), &options, &mut |_, _| {}).unwrap();
     let r = &map.report;
     assert!((r.flipped, r.wound_vertices) <= (plain.report.flipped, plain.report.wound_vertices), "{r:?}");
     assert!((r.grid_size / plain.report.grid_size - 1.0).abs() <= 0.031 && r.conflicts == 0, "{r:?}");
@@ -391,7 +392,8 @@ fn stiffer_fit_around_cones_mends_coarse_grids() {
 }
 
 /// Where the map winds twice around a point with no flipped triangle (the
-/// cow at 1 500 quads; spot > 40° at 3 000 until the rounding's local
+/// cow at 1 400 quads, at 1 500 until tube periods were kept three steps
+/// around; spot > 40° at 3 000 until the rounding's local
 /// stiffening, fandisk > 60° at 1 000 until the held pass widened its
 /// rows), the extractor
 /// closes the mesh instead of leaving holes: each cell traced around twice
@@ -404,7 +406,7 @@ fn cells_the_map_winds_around_are_closed_with_quads() {
     let input = load("cow.obj");
     let features = FeatureSet::none(&input);
     let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
-    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1500), &mut |_, _| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Quads(1400), &mut |_, _| {}).unwrap();
     assert_eq!(map.report.flipped, 0, "{:?}", map.report);
     assert!(map.report.wound_vertices > 0, "the case this tests is gone: {:?}", map.report);
     let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
@@ -416,7 +418,7 @@ fn cells_the_map_winds_around_are_closed_with_quads() {
     assert_eq!((r.euler_characteristic, r.boundary_loops, r.components), (solution.mesh.euler_characteristic(), 0, 1), "{r:?}");
     assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.unreferenced_vertices), (0, 0, 0), "{r:?}");
     assert_eq!(quads.uv.len(), 4 * quads.quads.len());
-    // Half the quads the 1 % target is set for (3 000): 1.1 % here.
+    // Half the quads the 1 % target is set for (3 000): under 1.5 % here.
     assert!(r.distance_input_to_quads_relative.unwrap() < 0.015, "{r:?}");
 }
 
@@ -437,36 +439,32 @@ fn quantizer_reruns_for_another_size() {
 }
 
 
-/// The cow without features at 2 000 quads: the rounding at the asked grid
+/// The cow without features at 1 200 quads: the rounding at the asked grid
 /// length folds the map; with a quad count the quantizer also rounds at
 /// grid lengths a few percent off and keeps the map with fewer flips (here
-/// none), while an explicit length is kept exactly. The quad mesh of that
-/// map is clean, with the input's Euler characteristic. (Spot at `--sharp
-/// 40`, 1 500 quads, was the case until the held pass widened its rows:
-/// now the asked length and its neighbours all leave 2 flipped.)
+/// none; it still winds around a few vertices), while an explicit length is
+/// kept exactly. (Its quad mesh is not clean: a thin part the rule of
+/// tube periods does not see, docs/STATUS.md, splits it in two. The cow
+/// at 2 000 quads was the case until tube periods were kept three steps
+/// around: now clean at the asked length; spot at `--sharp 40`, 1 500
+/// quads, until the held pass widened its rows.)
 #[test]
 fn nearby_grid_sizes_mend_a_folding_rounding() {
-    use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
     let input = load("cow.obj");
     let features = FeatureSet::none(&input);
     let solution = solve(&input, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
     let quantizer = solution.quantizer().unwrap();
-    let s = quantizer.grid_length(GridSize::Quads(2000)).unwrap();
+    let s = quantizer.grid_length(GridSize::Quads(1200)).unwrap();
     let exact = quantizer.quantize(&solution.mesh, GridSize::Length(s), &mut |_, _| {}).unwrap();
     assert_eq!(exact.report.grid_size, s);
     assert!(exact.report.flipped > 0, "the case this tests is gone: {:?}", exact.report);
-    let count = quantizer.quantize(&solution.mesh, GridSize::Quads(2000), &mut |_, _| {}).unwrap();
+    let count = quantizer.quantize(&solution.mesh, GridSize::Quads(1200), &mut |_, _| {}).unwrap();
     let r = &count.report;
     assert!(r.flipped < exact.report.flipped, "{} flipped, {} at the asked length", r.flipped, exact.report.flipped);
     assert!(r.grid_size != s && (r.grid_size / s - 1.0).abs() <= 0.031, "grid {} against {s}", r.grid_size);
-    assert_eq!((r.conflicts, r.flipped, r.wound_vertices), (0, 0, 0), "{r:?}");
-    assert_eq!(check_integer_grid("cow", &solution.mesh, &solution.features, &count.uv), (0, 0));
-    let quads = extract_quads(&solution.mesh, &count.uv, &ExtractOptions::default()).unwrap();
-    assert!(quads.defects.is_empty(), "{:?}", quads.defects);
-    let q = check_quads(&solution.mesh, &quads, &CheckOptions::default());
-    let (euler, loops) = (solution.mesh.euler_characteristic(), solution.mesh.boundary_loops().len());
-    assert_eq!((q.euler_characteristic, q.boundary_loops, q.components), (euler, loops, 1), "{q:?}");
-    assert_eq!((q.non_manifold_edges, q.unreferenced_vertices), (0, 0), "{q:?}");
+    assert_eq!((r.conflicts, r.flipped, r.periods_violated), (0, 0, 0), "{r:?}");
+    let (flipped, off_grid) = check_integer_grid("cow", &solution.mesh, &solution.features, &count.uv);
+    assert!(flipped == 0 && off_grid <= r.wound_vertices, "{flipped} flipped, {off_grid} off the grid: {r:?}");
 }
 
 /// A CAD kernel's cylinder (one band of long triangles around, caps of
@@ -598,6 +596,32 @@ fn parts_thinner_than_a_cell_are_held_apart() {
         let (flipped, off_grid, _) = check_integer_grid_counting_cones("xatlas-gazebo", &solution.mesh, &solution.features, &map.uv);
         assert_eq!((flipped, off_grid), (0, 0), "{sharp:?} {quads}");
     }
+}
+
+/// An open tube 2.3 cells around and 8 cells long: the seam translation
+/// around it is its circumference, and rounded to the nearest integer (2)
+/// it put two quads around the tube on the same four vertices (Euler
+/// characteristic 9 instead of 0, 7 non-manifold edges). Kept at three
+/// steps or more, the quad mesh is an open tube of 3 by 8 quads.
+#[test]
+fn a_tube_is_kept_three_grid_steps_around() {
+    use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
+    let s = 2.0 * PI / 2.3;
+    let raw = conemap::mesh::shapes::grid(24, 84, |u, v| {
+        let a = if u == 1.0 { 0.0 } else { 2.0 * PI * u };
+        [a.cos(), a.sin(), 8.0 * s * v]
+    });
+    let tube = TriMesh::from_raw(&raw).unwrap();
+    let features = FeatureSet::none(&tube);
+    let solution = solve(&tube, &features, &SolveOptions::default(), &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, GridSize::Length(s), &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert_eq!((r.tube_periods, r.periods_violated, r.flipped, r.conflicts), (1, 0, 0, 0), "{r:?}");
+    assert!(r.period_moves > 0, "the case this tests is gone: {r:?}");
+    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
+    assert!(quads.defects.is_empty(), "{:?}", quads.defects);
+    let q = check_quads(&solution.mesh, &quads, &CheckOptions::default());
+    assert_eq!((q.quads, q.euler_characteristic, q.boundary_loops, q.non_manifold_edges, q.flipped_quads), (24, 0, 2, 0, 0), "{q:?}");
 }
 
 /// One of the asset's braces alone (a slanted box 0.22 by 0.9 by 0.7, its

@@ -243,6 +243,10 @@ export interface QuantizeReport {
   /** Pairs of integers (cones, corners, isolines side by side) to be kept a grid line apart, and those left closer. */
   separations: number;
   separations_violated: number;
+  /** Seam translations around thin parts (a loop around a horn or a handle), integers moved to widen them to 3 grid steps or more, and those left narrower. */
+  tube_periods: number;
+  period_moves: number;
+  periods_violated: number;
   /** Separations held as rows of the solves in the pass kept (0 unless the map was still bad after the plain and stiffer passes). */
   separations_held: number;
   /** Of those, rows widened to more than one grid line so that the pairs the seams make them determine are parted too. */
@@ -340,6 +344,7 @@ export interface QuadsResult {
 
 export const QUANTIZE_REPORT_KEYS = {
   grid_size: true, point_forms: true, translation_forms: true, batches: true, separation_moves: true, separations: true,
+  tube_periods: true, period_moves: true, periods_violated: true,
   separations_violated: true, separations_held: true, separations_widened: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiffening: true, stiff_weight: true, graded_fit: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
   wound_vertices: true, cells: true, seconds: true,

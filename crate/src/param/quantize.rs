@@ -26,6 +26,12 @@
 //! [`super::separation`]) are rounded a line apart; where the other forms
 //! determine them on one line anyway (through a seam's translation, say),
 //! [`Quantizer::separate`] moves the integers that determine them.
+//! Likewise a seam translation around a thin part of the surface (the loop
+//! crossing that seam goes around a horn, a leg or a handle: [`periods`])
+//! is the part's circumference in grid steps; where the rounded forms make
+//! it less than three, two quads around the part would share their four
+//! vertices, and [`Quantizer::widen_periods`] moves the integers that
+//! determine it.
 //!
 //! Then [`Quantizer::polish`]: where the plain fit's rounded map is bad,
 //! the local stiffening of Bommes et al. 2009 (MIQ; [`Quantizer::stiffen`]:
@@ -47,8 +53,8 @@
 //! mended it (on meshes with the full budgets, for less distortion), the
 //! whole rounding runs again with the faces within
 //! one grid unit of every singular point [`STIFF_WEIGHTS`] times stiffer, so
-//! the ring moves with its point; the pass with the fewest collapsed faces,
-//! then wound vertices, then the least fit distortion is kept. Where the map
+//! the ring moves with its point; the pass with the fewest collapsed faces
+//! and narrow tube periods, then wound vertices, then the least fit distortion is kept. Where the map
 //! is still bad, one more pass holds the separations as rows
 //! ([`HeldApart`](super::separation::HeldApart)): every pair a solve leaves less than a grid line apart is
 //! held exactly one apart in the solves that follow, the collapse
@@ -87,7 +93,7 @@
 //!
 //! Here: the setup ([`Quantizer::new`]), the passes and which map is kept
 //! ([`Quantizer::quantize_with`]). The integer forms and curve ends are in
-//! [`forms`], the fit and its KKT in [`fit`], one rounding pass in
+//! [`forms`], the tube periods in [`periods`], the fit and its KKT in [`fit`], one rounding pass in
 //! [`rounding`], the polish and the measures of a bad map in [`polish`]
 //! (its patches in [`local`]), the parts in [`parts`].
 //!
@@ -98,7 +104,8 @@
 //! first batch, and at most [`WIDEN_TRIALS`](rounding::WIDEN_TRIALS) solves widening). With that factorization:
 //! one adjoint solve per violated separation and one solve per move tried
 //! (at most [`SEPARATION_TRIALS`](rounding::SEPARATION_TRIALS) per batch, fewer on large meshes:
-//! [`FULL_BUDGET_FACES`]); after the last batch, one
+//! [`FULL_BUDGET_FACES`]), and the same per narrow tube period (at most
+//! [`PERIOD_TRIALS`](periods::PERIOD_TRIALS) solves per batch); after the last batch, one
 //! adjoint solve per probed unknown and one solve per `uncollapse` trial
 //! (at most [`UNCOLLAPSE_TRIALS`](polish::UNCOLLAPSE_TRIALS), only where the map is bad), and one solve
 //! per ARAP iteration; the untangler of a stiffer pass factors the KKT once
@@ -129,6 +136,7 @@ use forms::{
     wedge_components, CurveEnd, Form, FormKind,
 };
 use parts::Part;
+use periods::{tube_periods, TubePeriod};
 use rounding::SizeRules;
 use serde::Serialize;
 use std::fmt;
@@ -137,6 +145,7 @@ mod fit;
 mod forms;
 mod local;
 mod parts;
+mod periods;
 mod polish;
 mod rounding;
 
@@ -263,6 +272,13 @@ pub struct QuantizeReport {
     /// (each one a collapse).
     pub separations: usize,
     pub separations_violated: usize,
+    /// Seam translations around thin parts of the surface (a loop around a
+    /// horn or a handle: its circumference in grid steps), the integers moved
+    /// to widen them to [`periods::TUBE_STEPS`] steps or more, and those left
+    /// narrower (two quads around the part on the same vertices).
+    pub tube_periods: usize,
+    pub period_moves: usize,
+    pub periods_violated: usize,
     /// Separations held as rows in the pass kept (0 unless the held pass
     /// was run and kept: [`HeldApart`](super::separation::HeldApart)), and those of them widened to
     /// more than one line so that dependent ones part too.
@@ -334,6 +350,8 @@ pub struct Quantizer {
     curve_ends: Vec<CurveEnd>,
     /// Per unknown: the form that is that unknown alone (`usize::MAX` if none).
     form_of: Vec<usize>,
+    /// Translations around thin parts, kept [`periods::TUBE_STEPS`] steps or more.
+    tube_periods: Vec<TubePeriod>,
     /// Per component: the pin wedge's two unknowns.
     pins: Vec<[usize; 2]>,
     /// The seamless map's unknowns (model units).
@@ -401,6 +419,7 @@ impl Quantizer {
         let form_of = single_unknown_forms(&forms, n_unknowns);
         let curve_ends = curve_ends(mesh, &placement.cut, &cut_sums, &field.isoline, &cut, &vars, &form_of, &seamless);
         let triples = collapse_triples(&elements, &forms, &form_of);
+        let tube_periods = tube_periods(mesh, &cut, &vars, &param.uv);
         let integral = integral_unknowns(mesh, placement, &cut, &vars, &singular, n_unknowns, &forms);
         let faces = mesh.faces().to_vec();
         let seamless_areas: Vec<f64> = (0..nf)
@@ -425,6 +444,7 @@ impl Quantizer {
             integral,
             curve_ends,
             form_of,
+            tube_periods,
             pins,
             seamless,
             map_area,
@@ -492,7 +512,7 @@ impl Quantizer {
         } else {
             self.round_parts(s, retry, options, progress)?
         };
-        let Rounded { mut x, values, batches, separation_moves, moved_integers, arap_iterations, stiffening, untangled, stiff_weight, separations, separations_held, separations_widened, separations_violated, free_curve_ends, graded, .. } = rounded;
+        let Rounded { mut x, values, batches, separation_moves, period_moves, periods_violated, moved_integers, arap_iterations, stiffening, untangled, stiff_weight, separations, separations_held, separations_widened, separations_violated, free_curve_ends, graded, .. } = rounded;
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
             if let (FormKind::Cone | FormKind::Point, [(i, 1)], Some(v)) =
@@ -536,6 +556,9 @@ impl Quantizer {
                 .count(),
             batches,
             separation_moves,
+            tube_periods: self.tube_periods.len(),
+            period_moves,
+            periods_violated,
             separations,
             separations_held,
             separations_widened,
@@ -576,12 +599,12 @@ impl Quantizer {
         let stiff = self.stiff_faces(&grid.x0);
         let plain_fit = Fit::new(&self.elements, &stiff, 1.0);
         let plain = self.round_and_polish(&plain_fit, &grid, Pass::default(), progress)?.expect("a plain pass");
-        let bad = |b: &Rounded| b.collapsed + b.wound > 0;
+        let bad = |b: &Rounded| b.faults() + b.wound > 0;
         let is_bad = |best: &Option<(Rounded, f64)>| best.as_ref().is_some_and(|(b, _)| bad(b));
         // Stiffer fits mend a few bad places next to cones; the held
         // separations mend collapses between parallel lines, and go first
         // where the plain fit leaves separations violated.
-        let few = bad(&plain) && plain.collapsed + plain.wound <= STIFF_PASS_LIMIT;
+        let few = bad(&plain) && plain.faults() + plain.wound <= STIFF_PASS_LIMIT;
         // Where only the polish mended the plain rounding (local
         // stiffening), the stiffer fits may round to less distortion: tried
         // on meshes with the full budgets.
@@ -628,7 +651,7 @@ impl Quantizer {
         // own way).
         for factor in RETRY_GRID_FACTORS.into_iter().filter(|_| retry) {
             let Some((b, _)) = best.as_ref() else { break };
-            if b.collapsed == 0 && (b.wound == 0 || !options.retry_wound) {
+            if b.faults() == 0 && (b.wound == 0 || !options.retry_wound) {
                 break;
             }
             let (held, best_pass) = (Pass { hold: b.separations_held > 0, widen: false }, b.pass);
@@ -653,7 +676,7 @@ impl Quantizer {
     /// of the rounding, kept only if it dominates ([`keep_dominant`]).
     fn held_passes(&self, fit: &Fit, grid: &GridStart, best: &mut Option<(Rounded, f64)>, progress: &mut dyn FnMut(usize, usize)) -> Result<(), QuantizeError> {
         let rounded = self.round_and_polish(fit, grid, Pass { hold: true, widen: false }, progress)?.expect("a held pass");
-        let widen = rounded.held_dropped > 0 && rounded.collapsed + rounded.wound > 0;
+        let widen = rounded.held_dropped > 0 && rounded.faults() + rounded.wound > 0;
         keep_better(best, rounded, grid.s);
         if widen {
             if let Some(rounded) = self.round_and_polish(fit, grid, Pass { hold: true, widen: true }, progress)? {
@@ -690,6 +713,8 @@ impl Quantizer {
             }
             joined.batches += r.batches;
             joined.separation_moves += r.separation_moves;
+            joined.period_moves += r.period_moves;
+            joined.periods_violated += r.periods_violated;
             joined.moved_integers += r.moved_integers;
             joined.arap_iterations = joined.arap_iterations.max(r.arap_iterations);
             joined.stiffening = joined.stiffening.max(r.stiffening);
@@ -765,6 +790,15 @@ impl Quantizer {
 
 }
 
+impl Rounded {
+    /// Collapsed or flipped faces and tube periods narrower than
+    /// [`periods::TUBE_STEPS`]: each leaves a hole or a non-manifold place
+    /// in the quad mesh (a wound vertex only a vertex of valence 3).
+    fn faults(&self) -> usize {
+        self.collapsed + self.periods_violated
+    }
+}
+
 /// The outcome of one [`Quantizer::round_and_polish`].
 #[derive(Default)]
 struct Rounded {
@@ -772,6 +806,10 @@ struct Rounded {
     values: Vec<Option<i64>>,
     batches: usize,
     separation_moves: usize,
+    /// Integers moved to widen tube periods ([`Quantizer::widen_periods`]),
+    /// and the periods `x` leaves narrower than [`periods::TUBE_STEPS`].
+    period_moves: usize,
+    periods_violated: usize,
     moved_integers: usize,
     arap_iterations: usize,
     untangled: bool,
@@ -827,20 +865,20 @@ struct GridStart {
 /// around is closed with quads (an extra singular vertex): fewer of the
 /// first, then of the second, count first.
 fn keep_better(best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64) {
-    let key = |r: &Rounded| (r.collapsed, r.wound, r.distortion);
+    let key = |r: &Rounded| (r.faults(), r.wound, r.distortion);
     if best.as_ref().is_none_or(|(b, _)| key(&candidate) < key(b)) {
         *best = Some((candidate, s));
     }
 }
 
 /// Keeps `candidate` (rounded at grid length `s`) over `best` only where it
-/// has no more collapsed faces and no more wound vertices, and fewer of
+/// has no more faults ([`Rounded::faults`]) and no more wound vertices, and fewer of
 /// both together: a pass that widens held rows stretches the map (more
 /// cells, more distortion), so it has to mend the map, not trade one fault
 /// for another.
 fn keep_dominant(best: &mut Option<(Rounded, f64)>, candidate: Rounded, s: f64) {
     let dominates = best.as_ref().is_none_or(|(b, _)| {
-        candidate.collapsed <= b.collapsed && candidate.wound <= b.wound && candidate.collapsed + candidate.wound < b.collapsed + b.wound
+        candidate.faults() <= b.faults() && candidate.wound <= b.wound && candidate.faults() + candidate.wound < b.faults() + b.wound
     });
     if dominates {
         *best = Some((candidate, s));

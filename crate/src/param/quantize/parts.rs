@@ -6,7 +6,7 @@
 //! never rounded in one batch of the whole mesh without a solve between
 //! them.
 
-use super::{CurveEnd, Form, Quantizer};
+use super::{CurveEnd, Form, Quantizer, TubePeriod};
 use crate::param::element::Element;
 
 /// One component of the mesh as a quantizer of its own, and where its
@@ -75,6 +75,7 @@ impl Part {
         let wedges = Numbering::new(wedge_part, n_parts);
         let rows = Numbering::new(q.seam_rows.iter().map(|r| first_part(r)).collect(), n_parts);
         let forms = Numbering::new(q.forms.iter().map(|f| first_part(&f.row)).collect(), n_parts);
+        let period_part: Vec<usize> = q.tube_periods.iter().map(|p| first_part(&p.rows[0])).collect();
         let pins = Numbering::new(q.pins.iter().map(|p| unknown_part[p[0]]).collect(), n_parts);
         let unknowns = Numbering::new(unknown_part, n_parts);
         let unknown = |u: usize| unknowns.local[u];
@@ -116,6 +117,14 @@ impl Part {
                         .map(|end| CurveEnd { form: forms.local[end.form], length: end.length })
                         .collect(),
                     form_of: unknown_ids.iter().map(|&u| q.form_of[u]).map(|i| if i == usize::MAX { i } else { forms.local[i] }).collect(),
+                    tube_periods: q
+                        .tube_periods
+                        .iter()
+                        .zip(&period_part)
+                        .filter(|&(_, &part)| part == c)
+                        .map(|(p, _)| p)
+                        .map(|p| TubePeriod { rows: [row(&p.rows[0]), row(&p.rows[1])] })
+                        .collect(),
                     pins: pins.of(c).map(|p| q.pins[p].map(unknown)).collect(),
                     seamless: unknown_ids.iter().map(|&u| q.seamless[u]).collect(),
                     map_area: seamless_areas.iter().map(|a| a.max(0.0)).sum(),

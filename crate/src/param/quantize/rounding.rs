@@ -53,6 +53,7 @@ impl Quantizer {
         let mut x = x0.to_vec();
         let mut batches = 0;
         let mut separation_moves = 0;
+        let mut period_moves = 0;
         let mut system = None;
         let mut held = HeldApart::default();
         let mut held_dropped = 0;
@@ -128,6 +129,9 @@ impl Quantizer {
                 let mut solved = solved;
                 self.restore_parity(&mut solved, &dependent, &mut values, x0, targets)?;
                 separation_moves += self.separate(&mut solved, &mut values, x0, targets, separations)?;
+                if !self.tube_periods.is_empty() {
+                    period_moves += self.widen_periods(&mut solved, &mut values, x0, targets, separations)?;
+                }
                 x = solved.x.clone();
                 if pass.hold {
                     held.hold_violated(separations, &x, NEAR_INTEGER);
@@ -178,11 +182,14 @@ impl Quantizer {
             }
         }
         let (collapsed, wound, distortion, separations_violated) = self.assess(&x, s, targets, separations);
+        let periods_violated = self.periods_violated(&x);
         Ok(Some(Rounded {
             x,
             values,
             batches,
             separation_moves,
+            period_moves,
+            periods_violated,
             moved_integers,
             arap_iterations: polish.arap_iterations,
             untangled: polish.untangled,
