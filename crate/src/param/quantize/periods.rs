@@ -23,7 +23,7 @@
 //! [`Quantizer::widen_periods`] moves the integers that determine it.
 
 use super::fit::RoundedSystem;
-use super::rounding::{distance_to_integer, widening_step};
+use super::rounding::distance_to_integer;
 use super::super::separation::Separations;
 use super::{corner_angle_sums, QuantizeError, Quantizer, NEAR_INTEGER};
 use crate::mesh::TriMesh;
@@ -152,19 +152,8 @@ impl Quantizer {
         let (mut moves, mut trials, max_trials) = (0, 0, self.budget(PERIOD_TRIALS));
         for period in &self.tube_periods {
             while period.violated(&system.x) && trials < max_trials {
-                let row = period.widening_row(x0);
-                let gain = system.sensitivity(&row)?;
+                let candidates = self.widening_moves(system, &period.widening_row(x0), values, x0)?;
                 trials += 1;
-                let mut candidates: Vec<(f64, usize, usize, i64)> = system
-                    .form_rows
-                    .iter()
-                    .filter_map(|&(form, row)| {
-                        let v = values[form]?;
-                        let step = widening_step(gain[row])?;
-                        Some((((v + step) as f64 - self.forms[form].value(x0)).abs(), form, row, step))
-                    })
-                    .collect();
-                candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                 let (steps_before, violated_before) = (steps(period.value(&system.x)), separations.violated(&system.x, NEAR_INTEGER).len());
                 let mut kept = false;
                 for (_, form, row, step) in candidates.into_iter().take(CANDIDATES_PER_PERIOD) {

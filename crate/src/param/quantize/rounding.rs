@@ -312,18 +312,7 @@ impl Quantizer {
                     break 'pairs;
                 }
                 trials += 1;
-                let gap_gain = system.sensitivity(&[(sep.hi, 1), (sep.lo, -1)])?;
-                let mut candidates: Vec<(f64, usize, usize, i64)> = system
-                    .form_rows
-                    .iter()
-                    .filter_map(|&(form, row)| {
-                        let v = values[form]?;
-                        let step = widening_step(gap_gain[row])?;
-                        let cost = ((v + step) as f64 - self.forms[form].value(x0)).abs();
-                        Some((cost, form, row, step))
-                    })
-                    .collect();
-                candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let candidates = self.widening_moves(system, &[(sep.hi, 1), (sep.lo, -1)], values, x0)?;
                 for &(_, form, row, step) in candidates.iter().take(CANDIDATES_PER_SEPARATION) {
                     if trials >= max_trials {
                         break 'pairs;
@@ -366,6 +355,32 @@ impl Quantizer {
             violated = after;
             moves += 1;
         }
+        Ok(moves)
+    }
+
+    /// The moves of rounded integers that widen the linear form `gap` (of the
+    /// unknowns) by about a grid line, cheapest first: per rounded row, its
+    /// step ([`widening_step`] of the gap's change per unit change of the
+    /// row, one adjoint solve for all rows), as `(cost, form, row, step)`,
+    /// the cost the moved value's distance from the seamless map's `x0`.
+    pub(super) fn widening_moves(
+        &self,
+        system: &RoundedSystem,
+        gap: &[(usize, i64)],
+        values: &[Option<i64>],
+        x0: &[f64],
+    ) -> Result<Vec<(f64, usize, usize, i64)>, QuantizeError> {
+        let gain = system.sensitivity(gap)?;
+        let mut moves: Vec<(f64, usize, usize, i64)> = system
+            .form_rows
+            .iter()
+            .filter_map(|&(form, row)| {
+                let v = values[form]?;
+                let step = widening_step(gain[row])?;
+                Some((((v + step) as f64 - self.forms[form].value(x0)).abs(), form, row, step))
+            })
+            .collect();
+        moves.sort_by(|a, b| a.0.total_cmp(&b.0));
         Ok(moves)
     }
 
