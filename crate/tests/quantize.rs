@@ -624,6 +624,33 @@ fn a_tube_is_kept_three_grid_steps_around() {
     assert_eq!((q.quads, q.euler_characteristic, q.boundary_loops, q.non_manifold_edges, q.flipped_quads), (24, 0, 2, 0, 0), "{q:?}");
 }
 
+/// A boundary vertex lies on an isoline, so its UV angle changes only by
+/// quarter turns; bff's punctured torus at 1 000 quads (solved as `quads`
+/// solves it) rounded a straight boundary vertex to a full turn, a hairpin
+/// whose two sides overlap on the isoline, and the next boundary vertex to
+/// a corner: two quad vertices at one grid point, traces that did not come
+/// back, 9 defect places. Counted as a vertex the map winds around, the
+/// fold sends the rounding on to the passes that mend it: no defect.
+#[test]
+fn a_boundary_folded_back_on_its_isoline_is_a_fault() {
+    use conemap::pipeline::RefineOptions;
+    use conemap::quads::{check_quads, extract_quads, CheckOptions, ExtractOptions};
+    let input = load("bff-punctured-torus.obj");
+    let grid = GridSize::Quads(1000);
+    let mut options = SolveOptions::default();
+    options.refine.max_edge_length = RefineOptions::for_quads(&input, grid).max_edge_length;
+    let options = options.for_quads(&input, grid);
+    let features = FeatureSet::none(&input);
+    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
+    let map = solution.quantizer().unwrap().quantize(&solution.mesh, grid, &mut |_, _| {}).unwrap();
+    let r = &map.report;
+    assert_eq!((r.flipped, r.wound_vertices, r.conflicts), (0, 0, 0), "{r:?}");
+    let quads = extract_quads(&solution.mesh, &map.uv, &ExtractOptions::default()).unwrap();
+    assert!(quads.defects.is_empty(), "{:?}", quads.defects);
+    let q = check_quads(&solution.mesh, &quads, &CheckOptions::default());
+    assert_eq!((q.euler_characteristic, q.boundary_loops, q.non_manifold_edges, q.flipped_quads), (-1, 1, 0, 0), "{q:?}");
+}
+
 /// One of the asset's braces alone (a slanted box 0.22 by 0.9 by 0.7, its
 /// edges sharper than 60° as features), turned and moved to twelve places,
 /// at grid lengths 0.20 to 0.29: the box is thinner than a cell, and its

@@ -363,6 +363,9 @@ pub struct Quantizer {
     /// UV angle sum of every vertex in the seamless map: quantization must
     /// keep it (a vertex off it by 2 pi winds without a flipped triangle).
     angle_sums: Vec<f64>,
+    /// Per vertex: on the mesh boundary (on an isoline, so its UV angle sum
+    /// can change only by quarter turns, each one a fold of the boundary).
+    on_boundary: Vec<bool>,
     map_area: f64,
     distortion_before: f64,
     /// On a mesh of several components: each as a quantizer of its own
@@ -434,6 +437,7 @@ impl Quantizer {
             seamless_areas,
             faces,
             angle_sums,
+            on_boundary: (0..mesh.n_vertices() as u32).map(|v| mesh.is_boundary_vertex(v)).collect(),
             seam_rows: seam_rows(mesh, &cut, &vars).rows,
             wedge: cut.wedge,
             elements,

@@ -131,6 +131,7 @@ impl Part {
                     seamless_areas,
                     faces: face_ids.iter().map(|&f| q.faces[f].map(|v| vertices.local[v as usize] as u32)).collect(),
                     angle_sums: vertices.of(c).map(|v| q.angle_sums[v]).collect(),
+                    on_boundary: vertices.of(c).map(|v| q.on_boundary[v]).collect(),
                     distortion_before: q.distortion_before,
                     elements,
                     forms: forms_c,

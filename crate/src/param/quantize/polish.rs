@@ -12,7 +12,7 @@ use super::super::untangle::{untangle, UntangleOptions, UntangleStats};
 use super::fit::{precondition, RoundedSystem};
 use super::{corner_angle_sums, local, QuantizeError, Quantizer, FULL_BUDGET_FACES, NEAR_INTEGER};
 use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector};
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_PI_4, PI};
 
 /// Share of its seamless-map UV area below which a triangle counts as
 /// collapsed (squeezed onto a grid line: the exact snapping of the integers
@@ -371,13 +371,21 @@ impl Quantizer {
     }
 
     /// Vertices whose UV angle sum is off the seamless map's by more than pi
-    /// (ascending).
+    /// inside, by more than an eighth of a turn on the boundary (ascending).
+    /// A boundary vertex lies on an isoline, and its angle changes by
+    /// quarter turns: a straight one turned to a full turn is a hairpin of
+    /// the boundary, whose two sides overlap on the isoline (bff's
+    /// punctured torus at 1 000 quads: two quad vertices at one grid point,
+    /// traces that do not come back).
     pub(super) fn wound_vertices(&self, x: &[f64]) -> Vec<u32> {
         let sums = corner_angle_sums(&self.faces, self.angle_sums.len(), |f| {
             self.elements[f].unknowns_uv(x)
         });
         (0..sums.len() as u32)
-            .filter(|&v| (sums[v as usize] - self.angle_sums[v as usize]).abs() > PI)
+            .filter(|&v| {
+                let limit = if self.on_boundary[v as usize] { FRAC_PI_4 } else { PI };
+                (sums[v as usize] - self.angle_sums[v as usize]).abs() > limit
+            })
             .collect()
     }
 
