@@ -273,7 +273,7 @@ export interface QuantizeReport {
   distortion_after: number;
   /** Flipped or degenerate triangles of the integer-grid map. */
   flipped: number;
-  /** Vertices around which the map winds (UV angle sum off the seamless map's by 2π). */
+  /** Vertices around which the map winds (UV angle sum off the seamless map's by 2π) or at which it folds the boundary back (off by a quarter turn or more). */
   wound_vertices: number;
   /** Total UV area in grid cells (about the number of quads). */
   cells: number;

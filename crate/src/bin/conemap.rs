@@ -742,7 +742,7 @@ fn print_quantization(r: &QuantizeReport) {
     }
     if r.flipped > 0 || r.wound_vertices > 0 {
         println!(
-            "  warning: the integer-grid map folds ({} flipped triangles, {} vertices it winds around); a nearby --quads or --grid often rounds cleanly",
+            "  warning: the integer-grid map folds ({} flipped triangles, {} vertices it winds around or folds the boundary at); a nearby --quads or --grid often rounds cleanly",
             r.flipped, r.wound_vertices
         );
     }

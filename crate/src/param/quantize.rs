@@ -315,7 +315,9 @@ pub struct QuantizeReport {
     pub distortion_after: f64,
     /// Flipped or degenerate triangles of the integer-grid map.
     pub flipped: usize,
-    /// Vertices around which the map winds (UV angle sum off the seamless map's by 2 pi).
+    /// Vertices around which the map winds (UV angle sum off the seamless
+    /// map's by 2 pi) or at which it folds the boundary back (by a quarter
+    /// turn or more on the boundary).
     pub wound_vertices: usize,
     /// Total UV area in grid cells (about the number of quads).
     pub cells: f64,

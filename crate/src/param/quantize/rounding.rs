@@ -1,7 +1,8 @@
 //! One greedy rounding pass: the forms closest to an integer first, in
 //! batches, the fit re-solved after each; separations restored by moving
 //! the integers that determine them ([`Quantizer::separate`]), or held as
-//! rows ([`HeldApart`]) and widened ([`Quantizer::widen_held`]); then the
+//! rows ([`HeldApart`]) and widened ([`Quantizer::widen_held`]); tube
+//! periods widened the same way ([`Quantizer::widen_periods`]); then the
 //! polish ([`super::polish`]).
 
 use super::super::separation::{HeldApart, Separation, Separations};
