@@ -292,6 +292,21 @@ impl RoundedSystem {
     pub(super) fn resolve(&self, q: &Quantizer, targets: &[[[f64; 2]; 2]]) -> Result<Vec<f64>, QuantizeError> {
         fit_solve(&self.solver, q, &self.weights, targets, &self.b)
     }
+
+    /// [`Self::resolve`] with the value of row `row` moved by `step` (a trial
+    /// move: one solve with the same factorization; the system is unchanged).
+    pub(super) fn resolve_moved(&self, q: &Quantizer, targets: &[[[f64; 2]; 2]], row: usize, step: i64) -> Result<Vec<f64>, QuantizeError> {
+        let mut b = self.b.clone();
+        b[row] += step as f64;
+        fit_solve(&self.solver, q, &self.weights, targets, &b)
+    }
+
+    /// Keeps a trial move: row `row`'s value moved by `step`, `x` its map
+    /// ([`Self::resolve_moved`]).
+    pub(super) fn take_move(&mut self, row: usize, step: i64, x: Vec<f64>) {
+        self.b[row] += step as f64;
+        self.x = x;
+    }
 }
 
 /// The map closest to per-face target Jacobians `targets` with face weights

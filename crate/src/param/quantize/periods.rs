@@ -161,21 +161,19 @@ impl Quantizer {
                         break;
                     }
                     trials += 1;
-                    system.b[row] += step as f64;
-                    let x = system.resolve(self, targets)?;
+                    let x = system.resolve_moved(self, targets, row, step)?;
                     let mut trial = values.to_vec();
                     trial[form] = values[form].map(|v| v + step);
                     if self.rounded_forms_integral(&trial, &x)
                         && steps(period.value(&x)) > steps_before
                         && separations.violated(&x, NEAR_INTEGER).len() <= violated_before
                     {
-                        system.x = x;
+                        system.take_move(row, step, x);
                         values.copy_from_slice(&trial);
                         self.take_determined_values(values, &system.x);
                         (moves, kept) = (moves + 1, true);
                         break;
                     }
-                    system.b[row] -= step as f64;
                 }
                 if !kept {
                     break;

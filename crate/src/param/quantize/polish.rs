@@ -267,20 +267,18 @@ impl Quantizer {
                     continue;
                 }
                 trials += 1;
-                system.b[row] += step as f64;
-                let moved = system.resolve(self, targets)?;
+                let moved = system.resolve_moved(self, targets, row, step)?;
                 let after = self.badness(&moved, s);
                 if self.rounded_forms_integral(values, &moved) && after < badness && separations.violated(&moved, NEAR_INTEGER).len() <= violated {
                     values[form] = Some(v);
                     self.take_determined_values(values, &moved);
-                    system.x = moved.clone();
-                    *x = moved;
+                    x.clone_from(&moved);
+                    system.take_move(row, step, moved);
                     badness = after;
                     kept += 1;
                     improved = true;
                     break;
                 }
-                system.b[row] -= step as f64;
             }
             if !improved {
                 break;

@@ -324,9 +324,7 @@ impl Quantizer {
                         continue;
                     }
                     trials += 1;
-                    system.b[row] += step as f64;
-                    let x = system.resolve(self, targets)?;
-                    system.b[row] -= step as f64;
+                    let x = system.resolve_moved(self, targets, row, step)?;
                     if !self.rounded_forms_integral(&trial, &x) {
                         continue;
                     }
@@ -348,8 +346,7 @@ impl Quantizer {
                 }
                 sideways += 1;
             }
-            system.b[row] += step as f64;
-            system.x = x;
+            system.take_move(row, step, x);
             values.copy_from_slice(&trial);
             self.take_determined_values(values, &system.x);
             seen.insert(values.to_vec());
@@ -421,8 +418,8 @@ impl Quantizer {
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             let Some((_, form, row, step)) = best else { break };
             values[form] = values[form].map(|v| v + step);
-            system.b[row] += step as f64;
-            system.x = system.resolve(self, targets)?;
+            let x = system.resolve_moved(self, targets, row, step)?;
+            system.take_move(row, step, x);
         }
         Ok(())
     }
@@ -475,16 +472,15 @@ impl Quantizer {
                     break;
                 }
                 trials += 1;
-                system.b[row] += step as f64;
-                let x = system.resolve(self, targets)?;
+                let x = system.resolve_moved(self, targets, row, step)?;
                 let after = held.violated(&x, NEAR_INTEGER);
                 if after.len() < violated.len() {
-                    (system.x, violated) = (x, after);
+                    system.take_move(row, step, x);
+                    violated = after;
                     held.gaps[k] += step;
                     widened += 1;
                     break;
                 }
-                system.b[row] -= step as f64;
             }
         }
         Ok(widened)
