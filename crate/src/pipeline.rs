@@ -348,6 +348,17 @@ impl Solution<'_> {
         })
     }
 
+    /// The edges of the mesh solved on that are pieces of the input edges
+    /// in `input_features` (a feature set of the input mesh), ascending.
+    pub fn solved_edges_of(&self, input_features: &FeatureSet) -> Vec<u32> {
+        (0..self.mesh.n_edges() as u32)
+            .filter(|&e| {
+                let orig = self.original_edge.as_ref().map_or(e, |oe| oe[e as usize]);
+                orig != crate::mesh::NONE && input_features.contains(orig)
+            })
+            .collect()
+    }
+
     /// Checks every requested feature edge (`requested`, on the INPUT mesh
     /// `input`) the way an outside checker does: the UV image of the edge,
     /// on both faces beside it, must be parallel to an axis.

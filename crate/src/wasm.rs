@@ -9,7 +9,7 @@ use crate::param::quantize::{GridSize, QuantizeReport, Quantizer};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
 use crate::quads::{self, check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
 use crate::pipeline::{self, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
-use crate::features::{FeatureSet, RefineCounts};
+use crate::features::{finer_than_grid, FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
 use crate::mesh::{self, LocatedProblem, MeshReport, RawMesh, TriMesh};
@@ -86,10 +86,24 @@ struct GridStage {
     /// The map solved again for the last quad count whose grid cancels
     /// opposite cones of `solution` ([`SolveOptions::for_quads`]).
     paired: Option<Paired>,
+    /// The map solved again without the feature curves the last quad count
+    /// whose map folded was too coarse to follow ([`Unfollowed`]).
+    unfollowed: Option<Unfollowed>,
     /// The solve's features and settings as solved (with the low-poly
     /// fallback's maximum edge length, if it took one), to solve again on the refinement.
     features: FeatureSet,
     options: SolveOptions,
+}
+
+/// The map of [`GridStage::solution`] solved again (for quads: opposite
+/// cones closer than a cell's diagonal cancelled) without the feature edges
+/// `dropped` ([`finer_than_grid`]), and its quantizer (`None` where that
+/// solve failed: not tried again for the same edges); used where the map
+/// with every feature folds and this one folds less, as
+/// [`pipeline::grid_map`] does.
+struct Unfollowed {
+    dropped: FeatureSet,
+    solved: Option<(Solution<'static>, Quantizer)>,
 }
 
 /// The map of [`GridStage::solution`] solved again with the cone pairs
@@ -319,7 +333,7 @@ impl MeshSession {
         let result = self.solution_object(mesh, &features, &sol)?;
         // As solved: a low-poly fallback's edge length is not asked again.
         let options = SolveOptions { refine: sol.refine_options, ..options };
-        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None, paired: None, features, options });
+        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None, paired: None, unfollowed: None, features, options });
         Ok(result)
     }
 
@@ -341,7 +355,7 @@ impl MeshSession {
         if let Some(refine) = pipeline::long_edges_refine(input, &grid.options.refine, Some(GridSize::Quads(quads as usize))) {
             let options = SolveOptions { refine, ..grid.options };
             match pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)) {
-                Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, paired: None, features: grid.features.clone(), options },
+                Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, paired: None, unfollowed: None, features: grid.features.clone(), options },
                 // Quads on the map the page shows rather than none; not asked again.
                 Err(_) => grid.options = options,
             }
@@ -361,18 +375,50 @@ impl MeshSession {
             });
             grid.paired = Some(Paired { pairs: pairs.clone(), solved });
         }
-        let input = self.valid_mesh()?;
+        // (Checked valid above; the field alone, so that `self.grid` can change below.)
+        let input = self.mesh.as_ref().ok_or_else(|| JsError::new("no mesh"))?;
         let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
         let (sol, quantizer, cancelled_pairs) = match &grid.paired {
             Some(Paired { pairs: p, solved: Some((solution, quantizer)) }) if !pairs.is_empty() && *p == pairs => (solution, quantizer, pairs.len()),
             _ => (&grid.solution, grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0),
         };
-        let map = quantizer
-            .quantize(&sol.mesh, GridSize::Quads(quads as usize), &mut |done, total| notify(progress, "quantization", done, total, None))
-            .map_err(|e| JsError::new(&e.to_string()))?;
+        let quantizing = &mut |done, total| notify(progress, "quantization", done, total, None);
+        let map = quantizer.quantize(&sol.mesh, size, quantizing).map_err(|e| JsError::new(&e.to_string()))?;
+        let dropped = if map.report.folds() > 0 { finer_than_grid(input, &grid.features, pipeline::quad_length(input, size)) } else { FeatureSet::none(input) };
+        let (sol, map, cancelled_pairs, dropped) = if dropped.is_empty() {
+            (sol, map, cancelled_pairs, dropped)
+        } else {
+            let Some(grid) = self.grid.as_mut() else {
+                return Err(JsError::new("solve the map before asking for quads").into());
+            };
+            if grid.unfollowed.as_ref().is_none_or(|u| u.dropped != dropped) {
+                let mut kept = grid.features.clone();
+                dropped.edges().for_each(|e| kept.set(input, e, false));
+                let solved = pipeline::solve(input, &kept, &grid.options.for_quads(input, size), &mut solve_progress(progress)).ok().and_then(|sol| {
+                    let quantizer = sol.quantizer().ok()?;
+                    Some((sol.into_owned(), quantizer))
+                });
+                grid.unfollowed = Some(Unfollowed { dropped: dropped.clone(), solved });
+            }
+            let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
+            let (sol, _, cancelled) = match &grid.paired {
+                Some(Paired { pairs: p, solved: Some((solution, quantizer)) }) if !pairs.is_empty() && *p == pairs => (solution, quantizer, pairs.len()),
+                _ => (&grid.solution, grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0),
+            };
+            let again = match &grid.unfollowed {
+                Some(Unfollowed { solved: Some((solution, quantizer)), .. }) => quantizer.quantize(&solution.mesh, size, quantizing).ok().map(|m| (solution, m)),
+                _ => None,
+            };
+            match again {
+                Some((solution, again)) if again.report.folds() < map.report.folds() => (solution, again, 0, dropped),
+                _ => (sol, map, cancelled, FeatureSet::none(input)),
+            }
+        };
         notify(progress, "quad extraction", 0, 0, None);
         let quad_mesh = extract_quads_along(&sol.mesh, &sol.features, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
-        let sharp: Vec<u32> = sol.features.edges().collect();
+        // Every feature asked for, the dropped ones too.
+        let requested = &self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?.features;
+        let sharp = sol.solved_edges_of(requested);
         let report = check_quads(&sol.mesh, &quad_mesh, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
         let uv: Vec<f32> = sol.input_corner_values(input, &map.uv).iter().flat_map(|p| p.map(|c| c as f32)).collect();
         let positions: Vec<f32> = quad_mesh.positions.iter().flat_map(|p| p.map(|c| c as f32)).collect();
@@ -393,6 +439,7 @@ impl MeshSession {
             defects: quad_mesh.defects.len(),
             cones: sol.placement.cones.len(),
             cancelled_pairs,
+            dropped_feature_edges: dropped.len(),
             solved_faces: sol.mesh.n_faces(),
             inserted_vertices: sol.splits,
             refinement: &sol.refinement,
@@ -636,6 +683,9 @@ struct QuadsResult<'a> {
     /// solve's map cancelled for this grid (closer than a cell's diagonal).
     cones: usize,
     cancelled_pairs: usize,
+    /// The input's feature edges the map was solved without, where the map
+    /// with all of them folded ([`finer_than_grid`]; 0: every feature kept).
+    dropped_feature_edges: usize,
     /// The mesh the map was solved on: its faces, the vertices inserted into
     /// the input, and why ([`pipeline::long_edges_refine`] may have refined it).
     solved_faces: usize,

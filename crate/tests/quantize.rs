@@ -546,6 +546,35 @@ fn a_low_poly_cad_grid_map_is_solved_again_where_it_folds() {
     assert!(folded_on_input > 0, "the input's own grid map no longer folds at any count: this test no longer exercises the second solve");
 }
 
+/// The teapot with its creases above 60° at 3 000 quads, solved as `quads`
+/// solves it: its one crease, the spout's lip (4 edges, 1.9 cells, half a
+/// turn), puts three +1 cones within half a cell and the grid map winds
+/// around vertices. `pipeline::grid_map` solves again without the curves
+/// finer than the grid (`features::finer_than_grid`) and keeps that map:
+/// no fold, an integer grid, the lip no feature of it.
+#[test]
+fn feature_curves_finer_than_the_grid_are_dropped_where_they_fold_the_map() {
+    use conemap::features::finer_than_grid;
+    use conemap::pipeline::{grid_map, quad_length, RefineOptions};
+    let input = load("teapot.obj");
+    let features = FeatureSet::sharp_edges(&input, 60.0);
+    let size = GridSize::Quads(3000);
+    let mut options = SolveOptions::default();
+    options.refine = RefineOptions::for_quads(&input, size);
+    let options = options.for_quads(&input, size);
+    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
+    let first = solution.quantizer().unwrap().quantize(&solution.mesh, size, &mut |_, _| {}).unwrap();
+    assert!(first.report.folds() > 0, "the map with the lip no longer folds: this test no longer exercises the fallback");
+    let finer = finer_than_grid(&input, &features, quad_length(&input, size));
+    assert_eq!((features.len(), finer.len()), (4, 4), "the lip is the one crease, and finer than the grid");
+    let mapped = grid_map(&input, &features, &options, solution, size, &QuantizeOptions::default(), &mut |_| {}, &mut |_, _| {}).unwrap();
+    assert_eq!(mapped.dropped_features, finer);
+    let (r, sol) = (&mapped.map.report, &mapped.solution);
+    assert_eq!((r.flipped, r.wound_vertices), (0, 0), "{r:?}");
+    assert!(sol.features.is_empty() && sol.solved_edges_of(&finer).len() >= 4, "solved without the lip, which is still found on the solved mesh");
+    assert_eq!(check_integer_grid("teapot >60° without its lip", &sol.mesh, &sol.features, &mapped.map.uv), (0, 0));
+}
+
 /// A feature curve that ends inside the surface is an isoline running on
 /// through its end, so only its constant is an integer: with the end's
 /// other coordinate an integer too, a curve shorter than a cell had its

@@ -130,6 +130,24 @@ test('quads cancel the opposite cones a coarse grid cannot keep apart, solving a
   assert.ok(fine.cancelled_pairs < r.cancelled_pairs && fine.cones > r.cones, `${fine.cancelled_pairs} pairs at 10 000 quads`);
 });
 
+test('quads drop the feature curves finer than the grid where the map with them folds, and say so', () => {
+  // The teapot's one crease above 60° is the spout's lip: 4 edges, under two quads at 3 000.
+  const session = open(sharedMesh('teapot'));
+  const sharp = session.sharp_edges(60);
+  assert.equal(sharp.length, 4);
+  session.solve(sharp, undefined, false, () => {});
+  const r = session.quads(3000, () => {});
+  assert.equal(r.dropped_feature_edges, 4, 'solved without the lip');
+  assert.equal(r.quantization.flipped + r.quantization.wound_vertices, 0, 'the map without the lip does not fold');
+  assert.equal(r.defects, 0);
+  assert.ok(r.report.sharp_edges_checked >= 4, 'the check still measures the dropped edges');
+  const again = new Set();
+  const r2 = session.quads(3000, (stage) => again.add(stage));
+  assert.deepEqual([...again], ['quantization', 'quad extraction'], 'the same edges dropped: no solve again');
+  assert.equal(r2.dropped_feature_edges, 4);
+  assert.equal(r2.report.quads, r.report.quads);
+});
+
 test('quads of a game asset of 56 parts: every part rounded on its own, the quad mesh closed', () => {
   const session = open(sharedMesh('xatlas-gazebo'));
   session.solve(new Uint32Array(), undefined, false, () => {});

@@ -332,6 +332,8 @@ export interface QuadsResult {
   /** Cones of the map quantized, and the pairs of opposite cones of the solve cancelled for this grid (closer than a cell's diagonal). */
   cones: number;
   cancelled_pairs: number;
+  /** Input feature edges the map was solved without: the map with them folded and the grid is too coarse to follow them (0: every feature kept). */
+  dropped_feature_edges: number;
   /** The mesh the map was solved on: its faces and the vertices inserted into the input (a low-poly mesh is refined for quads). */
   solved_faces: number;
   inserted_vertices: number;
@@ -359,7 +361,7 @@ export const QUAD_REPORT_KEYS = {
 } as const satisfies Keys<QuadReport>;
 export const QUADS_RESULT_KEYS = {
   quantization: true, report: true, uv: true, positions: true, quads: true, edges: true, singular: true, defects: true,
-  cones: true, cancelled_pairs: true, solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
+  cones: true, cancelled_pairs: true, dropped_feature_edges: true, solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
 } as const satisfies Keys<QuadsResult>;
 
 /** A solve as the page receives it: the wasm result and what the worker adds. */

@@ -293,6 +293,9 @@ function quadTable(s: Shown, counts: ReturnType<typeof valenceCounts>): HTMLDLis
       : fmtInt(s.result.cones)],
   ];
   if (boundarySingular > 0) rows.push(['Irregular boundary vertices', fmtInt(boundarySingular)]);
+  if (s.result.dropped_feature_edges > 0) {
+    rows.push(['Features not followed', `${fmtInt(s.result.dropped_feature_edges)} edges (short branches and small loops the quads are too large for; the map with them folded)`]);
+  }
   rows.push(
     ['Corner angle deviation (mean / max)', `${fmt(r.angle_mean_deviation, 1)}° / ${fmt(r.angle_max_deviation, 1)}°`],
     ['Quads with corners in 45°–135°', `${fmt(r.fraction_corners_45_135 * 100, 1)} %`],

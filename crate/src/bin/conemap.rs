@@ -6,7 +6,7 @@
 use conemap::cones::{self, BoundaryMode, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;
 use conemap::mesh::{analyze_located, Located, RawMesh, TriMesh};
-use conemap::param::quantize::{GridSize, IntegerGridMap, QuantizeOptions, QuantizeReport};
+use conemap::param::quantize::{GridSize, QuantizeOptions, QuantizeReport};
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -640,7 +640,7 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     let mut solution = solve_mesh(args, file, &input_file.mesh, &features, &options)?;
     times.cones = solution.refine_seconds + solution.placement.timings.total;
     times.param = clock.lap() - times.cones;
-    let mut grid_map = None;
+    let (mut grid_map, mut dropped_features) = (None, 0);
     if let Some(size) = grid {
         // A map solved again on the refinement for quads (where the input's
         // grid map folds) counts as quantization time.
@@ -649,6 +649,7 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
         let mapped = conemap::pipeline::grid_map(&input_file.mesh, &features, &options, solution, size, &quantize, &mut |p| bar.solve(p), &mut |_, _| {});
         bar.finish();
         let mapped = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+        dropped_features = mapped.dropped_features.len();
         (solution, grid_map) = (mapped.solution, Some(mapped.map));
     }
     let alignment = solution.feature_alignment(&input_file.mesh, &features);
@@ -684,12 +685,14 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
         let mut report = solve_report(&solution, &options.cones, &alignment, &written, &times);
         if let Some(g) = &grid_map {
             report["quantization"] = serde_json::json!(g.report);
+            report["dropped_feature_edges"] = serde_json::json!(dropped_features);
         }
         let text = serde_json::to_string_pretty(&report).map_err(|e| Failure(e.to_string(), 1))?;
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
     }
     print_solution(file, &solution, &alignment, &written, &times);
     if let Some(g) = &grid_map {
+        print_dropped_features(dropped_features);
         print_quantization(&g.report);
     }
     Ok(())
@@ -726,9 +729,15 @@ fn grid_option(args: &Args, flag: &str) -> Result<Option<GridSize>, Failure> {
 }
 
 /// The integer-grid map of `solution` for grid size `size`.
-fn quantize(file: &str, solution: &conemap::pipeline::Solution, size: GridSize, options: &QuantizeOptions) -> Result<IntegerGridMap, Failure> {
-    let quantizer = solution.quantizer().map_err(|e| Failure(format!("{file}: {e}"), 1))?;
-    quantizer.quantize_with(&solution.mesh, size, options, &mut |_, _| {}).map_err(|e| Failure(format!("{file}: {e}"), 1))
+/// The note on the feature edges a grid map was solved without
+/// ([`conemap::pipeline::grid_map`]), if any.
+fn print_dropped_features(dropped: usize) {
+    if dropped > 0 {
+        println!(
+            "  note: the map with every feature folds; solved without {dropped} feature edges the grid is too coarse to follow (branches and loops under {} quads); a smaller grid keeps them",
+            conemap::features::grid::MIN_CURVE_CELLS
+        );
+    }
 }
 
 /// The summary of a quantization.

@@ -4,17 +4,20 @@
 //! curve into two boundary curves").
 //!
 //! [`FeatureSet`] holds the edges; [`detect`] finds sharp creases and
-//! filters short fragments; [`cut`] opens the mesh along them; [`refine`]
+//! filters short fragments; [`grid`] finds the curves a quad grid is too
+//! coarse to follow; [`cut`] opens the mesh along them; [`refine`]
 //! inserts the vertices some configurations need before an aligned map exists.
 
 mod cut;
 mod delaunay;
 pub mod detect;
+pub mod grid;
 mod locate;
 mod refine;
 
 pub use cut::{boundary_turning, cut_open, CutMesh};
 pub use detect::{detect_sharp, MinLength, SharpDetection, SharpOptions, SharpStats};
+pub use grid::finer_than_grid;
 pub use refine::{
     faces_for_length, refine_for_features, refine_for_features_on, split_around, split_flipped, split_long_edges, RefineCounts, Refined,
     MAX_REFINED_FACES,

@@ -324,6 +324,14 @@ pub struct QuantizeReport {
     pub seconds: f64,
 }
 
+impl QuantizeReport {
+    /// The map's folds: flipped triangles and the vertices it winds around
+    /// (or folds the boundary at).
+    pub fn folds(&self) -> usize {
+        self.flipped + self.wound_vertices
+    }
+}
+
 /// An integer-grid map: one UV per face corner (`3 f + k`) in grid units.
 #[derive(Clone, Debug)]
 pub struct IntegerGridMap {

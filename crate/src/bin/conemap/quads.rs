@@ -2,7 +2,7 @@
 //! and the quad mesh traced on it, written as OBJ (quads) or glTF (each quad
 //! as two triangles plus a LINES primitive of the quad edges).
 
-use super::{check_writable, cone_options, grid_option, load_features, quantize, read_input, solve_mesh, solve_options, usage, Args, Failure};
+use super::{check_writable, cone_options, grid_option, load_features, read_input, solve_mesh, solve_options, usage, Args, Failure, ProgressLine};
 use conemap::param::quantize::{GridSize, QuantizeOptions};
 use conemap::quads::{check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
 use std::path::Path;
@@ -31,11 +31,17 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let options = solve_options(args, &input.mesh, max_edge)?.for_quads(&input.mesh, grid);
     let solution = solve_mesh(args, file, &input.mesh, &features, &options)?;
     let solve = clock.lap();
-    let map = quantize(file, &solution, grid, &QuantizeOptions::default())?;
+    // Solves again without the feature curves finer than the grid where
+    // they fold the map (counted as quantization time).
+    let bar = ProgressLine::new(args);
+    let mapped = conemap::pipeline::grid_map(&input.mesh, &features, &options, solution, grid, &QuantizeOptions::default(), &mut |p| bar.solve(p), &mut |_, _| {});
+    bar.finish();
+    let conemap::pipeline::GridMapped { solution, map, dropped_features } = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let quantize_seconds = clock.lap();
     let quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let extract = clock.lap();
-    let sharp: Vec<u32> = solution.features.edges().collect();
+    // Every feature asked for, the dropped ones too.
+    let sharp = solution.solved_edges_of(&features);
     let report = check_quads(&solution.mesh, &quads, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
     let check = clock.lap();
 
@@ -53,6 +59,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
             "input": file,
             "output": {"path": out, "bytes": data.len()},
             "cones": solution.placement.cones.len(),
+            "dropped_feature_edges": dropped_features.len(),
             "distortion_seamless": solution.param.metrics.distortion,
             "quantization": map.report,
             "quads": report,
@@ -63,6 +70,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
     }
     println!("{file}: {} vertices, {} faces, {} feature edges, {} cones", input.mesh.n_vertices(), input.mesh.n_faces(), features.len(), solution.placement.cones.len());
+    super::print_dropped_features(dropped_features.len());
     super::print_quantization(&map.report);
     print_quads(&report, quads.defects.len());
     println!("  wrote {out}: {} quads, {} vertices", quads.n_quads(), quads.n_vertices());
