@@ -90,6 +90,26 @@ fn quads_writes_a_quad_obj_and_its_report() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `conemap quads --sharp 60` on the teapot: the map with the spout's lip
+/// (4 edges, under two quads) folds, so it is solved without it; stdout
+/// says so, the report counts the 4 edges, and the sharp-edge figures still
+/// measure them.
+#[test]
+fn quads_say_which_features_the_grid_could_not_follow() {
+    let teapot = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes/teapot.obj");
+    let dir = std::env::temp_dir().join(format!("conemap-dropped-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (obj, report) = (dir.join("teapot-quads.obj"), dir.join("teapot-quads.json"));
+    let out = Command::new(env!("CARGO_BIN_EXE_conemap")).arg("quads").arg(teapot).arg("-o").arg(&obj).args(["--sharp", "60", "--quiet", "--report"]).arg(&report).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("solved without 4 feature edges"), "{}", String::from_utf8_lossy(&out.stdout));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["dropped_feature_edges"], 4);
+    assert_eq!(json["defects"].as_array().map(Vec::len), Some(0));
+    assert!(json["quads"]["sharp_edges_checked"].as_u64().unwrap() >= 4);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// `solve --quads` into a `.glb`: read back as the file's f32, every seam
 /// transition is a quarter turn plus an integer translation to the last bit
 /// and every cone an integer point, with coordinates of up to about 64 grid

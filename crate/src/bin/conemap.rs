@@ -109,7 +109,11 @@ commands:
                        folds on a mesh with edges longer than such quads
                        (a low-poly CAD export), it is solved again with
                        those edges split; the output is then the refined
-                       mesh.
+                       mesh. Where it still folds, it is solved again
+                       without the feature curves the grid is too coarse
+                       to follow (dangling branches and closed loops under
+                       two cells) and the map that folds less is kept
+                       (the report's dropped_feature_edges counts them).
 
   quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG]
              [--features FEATURES.json] [--report REPORT.json] [cone options]
@@ -123,7 +127,12 @@ commands:
                        map is solved on the input refined to --max-edge 5%
                        or 3.5 quads, whichever is shorter (the quads lie on
                        the input surface all the same), and opposite cones
-                       closer than a quad's diagonal cancel.
+                       closer than a quad's diagonal cancel. Where the map
+                       folds, it is solved again without the feature
+                       curves under two quads that dangle or close on
+                       themselves, and the map that folds less is kept
+                       (a note and the report's dropped_feature_edges say
+                       so; the sharp-edge figures still count them).
 
 options:
   -h, --help           print this help
