@@ -106,6 +106,27 @@ struct Unfollowed {
     solved: Option<(Solution<'static>, Quantizer)>,
 }
 
+impl GridStage {
+    /// The map quads are traced on where the grid's opposite cones closer
+    /// than a cell's diagonal are `pairs`: the [`Paired`] map where it
+    /// cancelled those pairs, else the solve's; its quantizer, and how many
+    /// pairs were cancelled.
+    fn quads_map(&self, pairs: &[(u32, u32)]) -> Result<(&Solution<'static>, &Quantizer, usize), JsError> {
+        match &self.paired {
+            Some(Paired { pairs: p, solved: Some((solution, quantizer)) }) if !pairs.is_empty() && p == pairs => Ok((solution, quantizer, pairs.len())),
+            _ => Ok((&self.solution, self.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0)),
+        }
+    }
+}
+
+/// `input` solved with `features` and `options` (reporting to `progress`)
+/// and its quantizer; `None` where either fails.
+fn solved_for_quads(input: &TriMesh, features: &FeatureSet, options: &SolveOptions, progress: &Function) -> Option<(Solution<'static>, Quantizer)> {
+    let sol = pipeline::solve(input, features, options, &mut solve_progress(progress)).ok()?;
+    let quantizer = sol.quantizer().ok()?;
+    Some((sol.into_owned(), quantizer))
+}
+
 /// The map of [`GridStage::solution`] solved again with the cone pairs
 /// `pairs` (cut vertices, [`cones::ConePlacement::close_pairs`]) cancelled
 /// and its quantizer (`None` where that solve failed: not tried again for
@@ -366,22 +387,14 @@ impl MeshSession {
         let size = GridSize::Quads(quads as usize);
         let pairs = grid.solution.placement.close_pairs(cones::GRID_PAIR_CELLS * pipeline::quad_length(input, size));
         if !pairs.is_empty() && grid.paired.as_ref().is_none_or(|p| p.pairs != pairs) {
-            let options = grid.options.for_quads(input, size);
-            let solved = pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress));
             // Where that fails, quads on the map without.
-            let solved = solved.ok().and_then(|sol| {
-                let quantizer = sol.quantizer().ok()?;
-                Some((sol.into_owned(), quantizer))
-            });
+            let solved = solved_for_quads(input, &grid.features, &grid.options.for_quads(input, size), progress);
             grid.paired = Some(Paired { pairs: pairs.clone(), solved });
         }
         // (Checked valid above; the field alone, so that `self.grid` can change below.)
         let input = self.mesh.as_ref().ok_or_else(|| JsError::new("no mesh"))?;
         let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
-        let (sol, quantizer, cancelled_pairs) = match &grid.paired {
-            Some(Paired { pairs: p, solved: Some((solution, quantizer)) }) if !pairs.is_empty() && *p == pairs => (solution, quantizer, pairs.len()),
-            _ => (&grid.solution, grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0),
-        };
+        let (sol, quantizer, cancelled_pairs) = grid.quads_map(&pairs)?;
         let quantizing = &mut |done, total| notify(progress, "quantization", done, total, None);
         let map = quantizer.quantize(&sol.mesh, size, quantizing).map_err(|e| JsError::new(&e.to_string()))?;
         let dropped = if map.report.folds() > 0 { finer_than_grid(input, &grid.features, pipeline::quad_length(input, size)) } else { FeatureSet::none(input) };
@@ -394,17 +407,11 @@ impl MeshSession {
             if grid.unfollowed.as_ref().is_none_or(|u| u.dropped != dropped) {
                 let mut kept = grid.features.clone();
                 dropped.edges().for_each(|e| kept.set(input, e, false));
-                let solved = pipeline::solve(input, &kept, &grid.options.for_quads(input, size), &mut solve_progress(progress)).ok().and_then(|sol| {
-                    let quantizer = sol.quantizer().ok()?;
-                    Some((sol.into_owned(), quantizer))
-                });
+                let solved = solved_for_quads(input, &kept, &grid.options.for_quads(input, size), progress);
                 grid.unfollowed = Some(Unfollowed { dropped: dropped.clone(), solved });
             }
             let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
-            let (sol, _, cancelled) = match &grid.paired {
-                Some(Paired { pairs: p, solved: Some((solution, quantizer)) }) if !pairs.is_empty() && *p == pairs => (solution, quantizer, pairs.len()),
-                _ => (&grid.solution, grid.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0),
-            };
+            let (sol, _, cancelled) = grid.quads_map(&pairs)?;
             let again = match &grid.unfollowed {
                 Some(Unfollowed { solved: Some((solution, quantizer)), .. }) => quantizer.quantize(&solution.mesh, size, quantizing).ok().map(|m| (solution, m)),
                 _ => None,
