@@ -687,7 +687,8 @@ struct QuadsResult<'a> {
     /// Places the extractor had to repair.
     defects: usize,
     /// Cones of the map quantized, and the pairs of opposite cones of the
-    /// solve's map cancelled for this grid (closer than a cell's diagonal).
+    /// solve's map cancelled for this grid (closer than a cell's diagonal;
+    /// 0 on a map solved without dropped features, which cancels its own).
     cones: usize,
     cancelled_pairs: usize,
     /// The input's feature edges the map was solved without, where the map

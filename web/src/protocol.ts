@@ -329,7 +329,7 @@ export interface QuadsResult {
   singular: Uint32Array;
   /** Places the extractor repaired (0 on a valid map). */
   defects: number;
-  /** Cones of the map quantized, and the pairs of opposite cones of the solve cancelled for this grid (closer than a cell's diagonal). */
+  /** Cones of the map quantized, and the pairs of opposite cones of the solve cancelled for this grid (closer than a cell's diagonal; 0 on a map solved without dropped features, which cancels its own). */
   cones: number;
   cancelled_pairs: number;
   /** Input feature edges the map was solved without: the map with them folded and the grid is too coarse to follow them (0: every feature kept). */
