@@ -5,7 +5,7 @@
 
 use crate::cones::{self, BoundaryMode, ComponentFigures, ComponentPlacement, Cone, ConeOptions, ConePlacement, ConeProgress, ConeTimings};
 use crate::export::{self, ExportInput, ExportOptions};
-use crate::param::quantize::{GridSize, QuantizeReport, Quantizer};
+use crate::param::quantize::{GridSize, QuantizeOptions, QuantizeReport, Quantizer};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
 use crate::quads::{self, check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
 use crate::pipeline::{self, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
@@ -396,8 +396,13 @@ impl MeshSession {
         let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
         let (sol, quantizer, cancelled_pairs) = grid.quads_map(&pairs)?;
         let quantizing = &mut |done, total| notify(progress, "quantization", done, total, None);
-        let map = quantizer.quantize(&sol.mesh, size, quantizing).map_err(|e| JsError::new(&e.to_string()))?;
-        let dropped = if map.report.folds() > 0 { finer_than_grid(input, &grid.features, pipeline::quad_length(input, size)) } else { FeatureSet::none(input) };
+        // As `pipeline::grid_map`: with curves to drop, a hopeless first
+        // rounding stops after its plain pass, and runs in full only if
+        // the map without them folds no less.
+        let finer = finer_than_grid(input, &grid.features, pipeline::quad_length(input, size));
+        let first = QuantizeOptions { plain_only_if_hopeless: !finer.is_empty(), ..QuantizeOptions::default() };
+        let map = quantizer.quantize_with(&sol.mesh, size, &first, quantizing).map_err(|e| JsError::new(&e.to_string()))?;
+        let dropped = if map.report.folds() > 0 { finer } else { FeatureSet::none(input) };
         let (sol, map, cancelled_pairs, dropped) = if dropped.is_empty() {
             (sol, map, cancelled_pairs, dropped)
         } else {
@@ -411,13 +416,17 @@ impl MeshSession {
                 grid.unfollowed = Some(Unfollowed { dropped: dropped.clone(), solved });
             }
             let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
-            let (sol, _, cancelled) = grid.quads_map(&pairs)?;
+            let (sol, quantizer, cancelled) = grid.quads_map(&pairs)?;
             let again = match &grid.unfollowed {
                 Some(Unfollowed { solved: Some((solution, quantizer)), .. }) => quantizer.quantize(&solution.mesh, size, quantizing).ok().map(|m| (solution, m)),
                 _ => None,
             };
             match again {
                 Some((solution, again)) if again.report.folds() < map.report.folds() => (solution, again, 0, dropped),
+                _ if map.report.passes_skipped => {
+                    let full = quantizer.quantize(&sol.mesh, size, quantizing).map_err(|e| JsError::new(&e.to_string()))?;
+                    (sol, if full.report.folds() <= map.report.folds() { full } else { map }, cancelled, FeatureSet::none(input))
+                }
                 _ => (sol, map, cancelled, FeatureSet::none(input)),
             }
         };

@@ -238,7 +238,7 @@ fn uv_grid_maps_round_again_where_they_wind_around_vertices() {
     assert_eq!((clean.report.flipped, clean.report.wound_vertices), (0, 0), "{:?}", clean.report);
     let plain = quantizer.quantize(&solution.mesh, GridSize::Quads(1000), &mut |_, _| {}).unwrap();
     assert!(plain.report.flipped == 0 && plain.report.wound_vertices > 0, "the case this test is about: {:?}", plain.report);
-    let options = QuantizeOptions { retry_wound: true };
+    let options = QuantizeOptions { retry_wound: true, ..QuantizeOptions::default() };
     let map = quantizer.quantize_with(&solution.mesh, GridSize::Quads(1000), &options, &mut |_, _| {}).unwrap();
     let r = &map.report;
     assert!((r.flipped, r.wound_vertices) <= (plain.report.flipped, plain.report.wound_vertices), "{r:?}");
@@ -527,7 +527,7 @@ fn a_low_poly_cad_grid_map_is_solved_again_where_it_folds() {
     use conemap::pipeline::grid_map;
     let input = common::fixture_mesh("cad/gear.obj");
     let features = FeatureSet::sharp_edges(&input, 60.0);
-    let quantize = QuantizeOptions { retry_wound: true };
+    let quantize = QuantizeOptions { retry_wound: true, ..QuantizeOptions::default() };
     let mut folded_on_input = 0;
     for quads in [2000, 3000, 4000] {
         let name = format!("gear at {quads} quads");

@@ -277,6 +277,8 @@ export interface QuantizeReport {
   wound_vertices: number;
   /** Total UV area in grid cells (about the number of quads). */
   cells: number;
+  /** Only the first pass ran: its map was hopeless and a map without the feature curves finer than the grid was tried instead. */
+  passes_skipped: boolean;
   seconds: number;
 }
 
@@ -349,7 +351,7 @@ export const QUANTIZE_REPORT_KEYS = {
   tube_periods: true, period_moves: true, periods_violated: true,
   separations_violated: true, separations_held: true, separations_widened: true, curve_ends: true, free_curve_ends: true, moved_integers: true, arap_iterations: true, stiffening: true, stiff_weight: true, graded_fit: true,
   untangled: true, conflicts: true, integer_residual: true, distortion_before: true, distortion_after: true, flipped: true,
-  wound_vertices: true, cells: true, seconds: true,
+  wound_vertices: true, cells: true, passes_skipped: true, seconds: true,
 } as const satisfies Keys<QuantizeReport>;
 export const QUAD_REPORT_KEYS = {
   quads: true, vertices: true, edges: true, euler_characteristic: true, boundary_loops: true, components: true,

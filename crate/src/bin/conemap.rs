@@ -654,7 +654,7 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
         // A map solved again on the refinement for quads (where the input's
         // grid map folds) counts as quantization time.
         let bar = ProgressLine::new(args);
-        let quantize = QuantizeOptions { retry_wound: true };
+        let quantize = QuantizeOptions { retry_wound: true, ..QuantizeOptions::default() };
         let mapped = conemap::pipeline::grid_map(&input_file.mesh, &features, &options, solution, size, &quantize, &mut |p| bar.solve(p), &mut |_, _| {});
         bar.finish();
         let mapped = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;

@@ -178,6 +178,16 @@ const GRADED_FIRST_RINGS: usize = 3;
 /// more roundings for little.
 const STIFF_PASS_LIMIT: usize = 16;
 
+/// With [`QuantizeOptions::plain_only_if_hopeless`], the plain fit's map
+/// with more collapsed faces and wound vertices than this is given up
+/// after that pass. Creases marked by angle on organic meshes left
+/// 203-771 (bff-face >60 at 3 000 and 1 000 quads, cow >60 at 3 000 and
+/// 1 000), and the other passes never mended them (bff-face >60 at 1 000:
+/// about 400 s for 329 defect places); plain maps the other passes made
+/// clean or nearly so had 10-24 (spot >40 at 1 000 and 3 000, bff-bunny
+/// >40 at 3 000).
+const HOPELESS_PLACES: usize = 4 * STIFF_PASS_LIMIT;
+
 /// Meshes up to this many faces get the full budgets of extra solves
 /// ([`SEPARATION_TRIALS`](rounding::SEPARATION_TRIALS), [`UNCOLLAPSE_TRIALS`](polish::UNCOLLAPSE_TRIALS), [`UNCOLLAPSE_PROBES`](polish::UNCOLLAPSE_PROBES) and
 /// the untangler's default iterations); larger ones a share `FULL_BUDGET_FACES
@@ -208,6 +218,12 @@ pub struct QuantizeOptions {
     /// length); the quad extractor closes its cell with quads instead, so
     /// quads do not pay for the retries (fandisk >60° at 1 000: 8 s -> 16 s).
     pub retry_wound: bool,
+    /// Stop after the plain pass where its map is bad in more than
+    /// [`HOPELESS_PLACES`] places, for a caller that has a better way out
+    /// ([`crate::pipeline::grid_map`]: the map without the feature curves
+    /// finer than the grid) and quantizes again without this where that
+    /// fails. [`QuantizeReport::passes_skipped`] says when it stopped.
+    pub plain_only_if_hopeless: bool,
 }
 
 /// Why quantization failed.
@@ -321,6 +337,9 @@ pub struct QuantizeReport {
     pub wound_vertices: usize,
     /// Total UV area in grid cells (about the number of quads).
     pub cells: f64,
+    /// Only the plain pass ran: its map was hopeless and the caller has
+    /// another way out ([`QuantizeOptions::plain_only_if_hopeless`]).
+    pub passes_skipped: bool,
     pub seconds: f64,
 }
 
@@ -526,7 +545,7 @@ impl Quantizer {
         } else {
             self.round_parts(s, retry, options, progress)?
         };
-        let Rounded { mut x, values, batches, separation_moves, period_moves, periods_violated, moved_integers, arap_iterations, stiffening, untangled, stiff_weight, separations, separations_held, separations_widened, separations_violated, free_curve_ends, graded, .. } = rounded;
+        let Rounded { mut x, values, batches, separation_moves, period_moves, periods_violated, moved_integers, arap_iterations, stiffening, untangled, stiff_weight, separations, separations_held, separations_widened, separations_violated, free_curve_ends, graded, passes_skipped, .. } = rounded;
         // Singular points and isolines exactly on the grid (they are single unknowns).
         for (form, value) in self.forms.iter().zip(&values) {
             if let (FormKind::Cone | FormKind::Point, [(i, 1)], Some(v)) =
@@ -592,6 +611,7 @@ impl Quantizer {
             flipped,
             wound_vertices: self.wound_vertices(&x).len(),
             cells,
+            passes_skipped,
             seconds: clock.lap(),
         };
         Ok(IntegerGridMap { uv, report })
@@ -612,7 +632,11 @@ impl Quantizer {
         let grid = self.grid_start(s);
         let stiff = self.stiff_faces(&grid.x0);
         let plain_fit = Fit::new(&self.elements, &stiff, 1.0);
-        let plain = self.round_and_polish(&plain_fit, &grid, Pass::default(), progress)?.expect("a plain pass");
+        let mut plain = self.round_and_polish(&plain_fit, &grid, Pass::default(), progress)?.expect("a plain pass");
+        if options.plain_only_if_hopeless && plain.faults() + plain.wound > HOPELESS_PLACES {
+            plain.passes_skipped = true;
+            return Ok((plain, s));
+        }
         let bad = |b: &Rounded| b.faults() + b.wound > 0;
         let is_bad = |best: &Option<(Rounded, f64)>| best.as_ref().is_some_and(|(b, _)| bad(b));
         // Stiffer fits mend a few bad places next to cones; the held
@@ -726,6 +750,7 @@ impl Quantizer {
                 (largest, s_joined, joined.stiff_weight, joined.graded) = (q.map_area, s_part, r.stiff_weight, r.graded);
             }
             joined.batches += r.batches;
+            joined.passes_skipped |= r.passes_skipped;
             joined.separation_moves += r.separation_moves;
             joined.period_moves += r.period_moves;
             joined.periods_violated += r.periods_violated;
@@ -816,6 +841,8 @@ impl Rounded {
 /// The outcome of one [`Quantizer::round_and_polish`].
 #[derive(Default)]
 struct Rounded {
+    /// The plain pass alone, given up as hopeless ([`QuantizeOptions::plain_only_if_hopeless`]).
+    passes_skipped: bool,
     x: Vec<f64>,
     values: Vec<Option<i64>>,
     batches: usize,

@@ -185,6 +185,7 @@ impl Quantizer {
         let (collapsed, wound, distortion, separations_violated) = self.assess(&x, s, targets, separations);
         let periods_violated = self.periods_violated(&x);
         Ok(Some(Rounded {
+            passes_skipped: false,
             x,
             values,
             batches,
