@@ -37,8 +37,9 @@ pub struct GridMapped<'a> {
 /// every feature wins ties. With such curves, the first rounding stops
 /// after its plain pass where that leaves a hopeless map
 /// ([`QuantizeOptions::plain_only_if_hopeless`]: bff-face with creases
-/// above 60° at 1 000 quads, 593 -> ... s), and runs its other passes only
-/// where the map without them folds no less.
+/// above 60° at 1 000 quads, about 500 -> 67 s for the same quads; cow at
+/// 3 000, 103 -> 64 s), and runs its other passes only where the map
+/// without them folds no less.
 /// `solve_progress` reports the other solves, `progress` each quantization.
 pub fn grid_map<'a>(
     mesh: &'a TriMesh,
