@@ -119,6 +119,11 @@ impl GridStage {
     }
 }
 
+/// The error of a quads request before any solve.
+fn unsolved() -> JsError {
+    JsError::new("solve the map before asking for quads")
+}
+
 /// `input` solved with `features` and `options` (reporting to `progress`)
 /// and its quantizer; `None` where either fails.
 fn solved_for_quads(input: &TriMesh, features: &FeatureSet, options: &SolveOptions, progress: &Function) -> Option<(Solution<'static>, Quantizer)> {
@@ -371,7 +376,7 @@ impl MeshSession {
     pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
         self.valid_mesh()?;
         let (Some(input), Some(grid)) = (self.mesh.as_ref(), self.grid.as_mut()) else {
-            return Err(JsError::new("solve the map before asking for quads").into());
+            return Err(unsolved().into());
         };
         if let Some(refine) = pipeline::long_edges_refine(input, &grid.options.refine, Some(GridSize::Quads(quads as usize))) {
             let options = SolveOptions { refine, ..grid.options };
@@ -393,7 +398,7 @@ impl MeshSession {
         }
         // (Checked valid above; the field alone, so that `self.grid` can change below.)
         let input = self.mesh.as_ref().ok_or_else(|| JsError::new("no mesh"))?;
-        let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
+        let grid = self.grid.as_ref().ok_or_else(unsolved)?;
         let (sol, quantizer, cancelled_pairs) = grid.quads_map(&pairs)?;
         let quantizing = &mut |done, total| notify(progress, "quantization", done, total, None);
         // As `pipeline::grid_map`: with curves to drop, a hopeless first
@@ -407,15 +412,13 @@ impl MeshSession {
             (sol, map, cancelled_pairs, dropped)
         } else {
             let Some(grid) = self.grid.as_mut() else {
-                return Err(JsError::new("solve the map before asking for quads").into());
+                return Err(unsolved().into());
             };
             if grid.unfollowed.as_ref().is_none_or(|u| u.dropped != dropped) {
-                let mut kept = grid.features.clone();
-                dropped.edges().for_each(|e| kept.set(input, e, false));
-                let solved = solved_for_quads(input, &kept, &grid.options.for_quads(input, size), progress);
+                let solved = solved_for_quads(input, &grid.features.without(&dropped), &grid.options.for_quads(input, size), progress);
                 grid.unfollowed = Some(Unfollowed { dropped: dropped.clone(), solved });
             }
-            let grid = self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
+            let grid = self.grid.as_ref().ok_or_else(unsolved)?;
             let (sol, quantizer, cancelled) = grid.quads_map(&pairs)?;
             let again = match &grid.unfollowed {
                 Some(Unfollowed { solved: Some((solution, quantizer)), .. }) => quantizer.quantize(&solution.mesh, size, quantizing).ok().map(|m| (solution, m)),
@@ -433,7 +436,7 @@ impl MeshSession {
         notify(progress, "quad extraction", 0, 0, None);
         let quad_mesh = extract_quads_along(&sol.mesh, &sol.features, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
         // Every feature asked for, the dropped ones too.
-        let requested = &self.grid.as_ref().ok_or_else(|| JsError::new("solve the map before asking for quads"))?.features;
+        let requested = &self.grid.as_ref().ok_or_else(unsolved)?.features;
         let sharp = sol.solved_edges_of(requested);
         let report = check_quads(&sol.mesh, &quad_mesh, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
         let uv: Vec<f32> = sol.input_corner_values(input, &map.uv).iter().flat_map(|p| p.map(|c| c as f32)).collect();

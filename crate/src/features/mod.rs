@@ -105,6 +105,11 @@ impl FeatureSet {
         }
     }
 
+    /// These features less those of `other` (same mesh).
+    pub fn without(&self, other: &FeatureSet) -> FeatureSet {
+        FeatureSet { is_feature: self.is_feature.iter().zip(&other.is_feature).map(|(&a, &b)| a && !b).collect() }
+    }
+
     /// True when edge `e` is a feature.
     pub fn contains(&self, e: u32) -> bool {
         self.is_feature[e as usize]

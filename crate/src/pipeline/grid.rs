@@ -68,10 +68,7 @@ pub fn grid_map<'a>(
         }
     }
     if best.map.report.folds() > 0 && !dropped.is_empty() {
-        let mut kept = features.clone();
-        for e in dropped.edges() {
-            kept.set(mesh, e, false);
-        }
+        let kept = features.without(&dropped);
         if let Some(again) = solve_and_quantize(mesh, &kept, &options, size, quantize, solve_progress, progress) {
             let solution = again.solution.into_owned();
             keep_fewer_folds(&mut best, GridMapped { solution, map: again.map, dropped_features: dropped });
