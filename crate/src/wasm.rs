@@ -5,11 +5,11 @@
 
 use crate::cones::{self, BoundaryMode, ComponentFigures, ComponentPlacement, Cone, ConeOptions, ConePlacement, ConeProgress, ConeTimings};
 use crate::export::{self, ExportInput, ExportOptions};
-use crate::param::quantize::{GridSize, QuantizeOptions, QuantizeReport, Quantizer};
+use crate::param::quantize::{GridSize, QuantizeOptions, QuantizeReport};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
 use crate::quads::{self, check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
-use crate::pipeline::{self, FeatureAlignment, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
-use crate::features::{finer_than_grid, FeatureSet, RefineCounts};
+use crate::pipeline::{FeatureAlignment, GridMapped, GridStage, LongEdges, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
+use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
 use crate::mesh::{self, LocatedProblem, MeshReport, RawMesh, TriMesh};
@@ -72,73 +72,6 @@ pub struct MeshSession {
     grid: Option<GridStage>,
     refine: RefineOptions,
     boundary: BoundaryMode,
-}
-
-/// The map quads are traced on and its quantizer: changing the quad count
-/// re-runs only quantization and extraction, unless the new grid cancels
-/// other cone pairs ([`Paired`]).
-struct GridStage {
-    /// The last solve's map; for a mesh whose edges are longer than a quad
-    /// mesh wants ([`pipeline::long_edges_refine`]), replaced on the first quads
-    /// request by the map solved on its refinement.
-    solution: Solution<'static>,
-    quantizer: Option<Quantizer>,
-    /// The map solved again for the last quad count whose grid cancels
-    /// opposite cones of `solution` ([`SolveOptions::for_quads`]).
-    paired: Option<Paired>,
-    /// The map solved again without the feature curves the last quad count
-    /// whose map folded was too coarse to follow ([`Unfollowed`]).
-    unfollowed: Option<Unfollowed>,
-    /// The solve's features and settings as solved (with the low-poly
-    /// fallback's maximum edge length, if it took one), to solve again on the refinement.
-    features: FeatureSet,
-    options: SolveOptions,
-}
-
-/// The map of [`GridStage::solution`] solved again (for quads: opposite
-/// cones closer than a cell's diagonal cancelled) without the feature edges
-/// `dropped` ([`finer_than_grid`]), and its quantizer (`None` where that
-/// solve failed: not tried again for the same edges); used where the map
-/// with every feature folds and this one folds less, as
-/// [`pipeline::grid_map`] does.
-struct Unfollowed {
-    dropped: FeatureSet,
-    solved: Option<(Solution<'static>, Quantizer)>,
-}
-
-impl GridStage {
-    /// The map quads are traced on where the grid's opposite cones closer
-    /// than a cell's diagonal are `pairs`: the [`Paired`] map where it
-    /// cancelled those pairs, else the solve's; its quantizer, and how many
-    /// pairs were cancelled.
-    fn quads_map(&self, pairs: &[(u32, u32)]) -> Result<(&Solution<'static>, &Quantizer, usize), JsError> {
-        match &self.paired {
-            Some(Paired { pairs: p, solved: Some((solution, quantizer)) }) if !pairs.is_empty() && p == pairs => Ok((solution, quantizer, pairs.len())),
-            _ => Ok((&self.solution, self.quantizer.as_ref().ok_or_else(|| JsError::new("no quantizer"))?, 0)),
-        }
-    }
-}
-
-/// The error of a quads request before any solve.
-fn unsolved() -> JsError {
-    JsError::new("solve the map before asking for quads")
-}
-
-/// `input` solved with `features` and `options` (reporting to `progress`)
-/// and its quantizer; `None` where either fails.
-fn solved_for_quads(input: &TriMesh, features: &FeatureSet, options: &SolveOptions, progress: &Function) -> Option<(Solution<'static>, Quantizer)> {
-    let sol = pipeline::solve(input, features, options, &mut solve_progress(progress)).ok()?;
-    let quantizer = sol.quantizer().ok()?;
-    Some((sol.into_owned(), quantizer))
-}
-
-/// The map of [`GridStage::solution`] solved again with the cone pairs
-/// `pairs` (cut vertices, [`cones::ConePlacement::close_pairs`]) cancelled
-/// and its quantizer (`None` where that solve failed: not tried again for
-/// the same pairs), kept while the quad count asked for cancels the same pairs.
-struct Paired {
-    pairs: Vec<(u32, u32)>,
-    solved: Option<(Solution<'static>, Quantizer)>,
 }
 
 /// A solve run in steps: its features and settings, its cone stage and the
@@ -358,86 +291,42 @@ impl MeshSession {
         let sol = stage.finish(mesh, &features, placed, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
         // As solved: a low-poly fallback's edge length is not asked again.
-        let options = SolveOptions { refine: sol.refine_options, ..options };
-        self.grid = Some(GridStage { solution: sol.into_owned(), quantizer: None, paired: None, unfollowed: None, features, options });
+        self.grid = Some(GridStage::new(sol.into_owned(), features, options, LongEdges::RefineFirst));
         Ok(result)
     }
 
     /// The integer-grid map of the last solve for about `quads` grid cells
-    /// and the quad mesh traced on it (a [`QuadsResult`]); re-runs only
-    /// quantization and extraction, except on the first call for a mesh
-    /// with edges longer than a quad mesh wants: the map is then solved
-    /// again on its refinement (`pipeline::long_edges_refine`; where that solve
-    /// fails, the last solve's map is used), and where the grid cancels
-    /// opposite cones closer than a cell's diagonal that the last such call
-    /// did not ([`SolveOptions::for_quads`], [`Paired`]; where that solve
-    /// fails, the map without). Throws when nothing was solved
-    /// yet, or with the quantization error (a free boundary, say).
+    /// and the quad mesh traced on it (a [`QuadsResult`]), by
+    /// [`GridStage::map`]: re-runs only quantization and extraction, unless
+    /// this grid asks for a solve that the last calls did not (the first
+    /// call on a mesh with edges longer than a quad mesh wants, opposite
+    /// cones the grid puts closer than a cell's diagonal, feature curves
+    /// finer than a grid that folds the map). Throws when nothing was
+    /// solved yet, or with the quantization error (a free boundary, say).
     pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
         self.valid_mesh()?;
-        let (Some(input), Some(grid)) = (self.mesh.as_ref(), self.grid.as_mut()) else {
-            return Err(unsolved().into());
-        };
-        if let Some(refine) = pipeline::long_edges_refine(input, &grid.options.refine, Some(GridSize::Quads(quads as usize))) {
-            let options = SolveOptions { refine, ..grid.options };
-            match pipeline::solve(input, &grid.features, &options, &mut solve_progress(progress)) {
-                Ok(sol) => *grid = GridStage { solution: sol.into_owned(), quantizer: None, paired: None, unfollowed: None, features: grid.features.clone(), options },
-                // Quads on the map the page shows rather than none; not asked again.
-                Err(_) => grid.options = options,
-            }
-        }
-        if grid.quantizer.is_none() {
-            grid.quantizer = Some(grid.solution.quantizer().map_err(|e| JsError::new(&e.to_string()))?);
-        }
+        // Out of the session while it runs, so that the result may borrow
+        // both; back in whatever happens.
+        let mut grid = self.grid.take().ok_or_else(|| JsError::new("solve the map before asking for quads"))?;
+        let result = self.quads_on(&mut grid, quads, progress);
+        self.grid = Some(grid);
+        result
+    }
+}
+
+impl MeshSession {
+    /// [`MeshSession::quads`] on `grid`.
+    fn quads_on(&self, grid: &mut GridStage, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
+        let input = self.valid_mesh()?;
         let size = GridSize::Quads(quads as usize);
-        let pairs = grid.solution.placement.close_pairs(cones::GRID_PAIR_CELLS * pipeline::quad_length(input, size));
-        if !pairs.is_empty() && grid.paired.as_ref().is_none_or(|p| p.pairs != pairs) {
-            // Where that fails, quads on the map without.
-            let solved = solved_for_quads(input, &grid.features, &grid.options.for_quads(input, size), progress);
-            grid.paired = Some(Paired { pairs: pairs.clone(), solved });
-        }
-        // (Checked valid above; the field alone, so that `self.grid` can change below.)
-        let input = self.mesh.as_ref().ok_or_else(|| JsError::new("no mesh"))?;
-        let grid = self.grid.as_ref().ok_or_else(unsolved)?;
-        let (sol, quantizer, cancelled_pairs) = grid.quads_map(&pairs)?;
+        // Every feature asked for, the dropped ones too (the map borrows the stage).
+        let requested = grid.features().clone();
         let quantizing = &mut |done, total| notify(progress, "quantization", done, total, None);
-        // As `pipeline::grid_map`: with curves to drop, a hopeless first
-        // rounding stops after its plain pass, and runs in full only if
-        // the map without them folds no less.
-        let finer = finer_than_grid(input, &grid.features, pipeline::quad_length(input, size));
-        let first = QuantizeOptions { plain_only_if_hopeless: !finer.is_empty(), ..QuantizeOptions::default() };
-        let map = quantizer.quantize_with(&sol.mesh, size, &first, quantizing).map_err(|e| JsError::new(&e.to_string()))?;
-        let dropped = if map.report.folds() > 0 { finer } else { FeatureSet::none(input) };
-        let (sol, map, cancelled_pairs, dropped) = if dropped.is_empty() {
-            (sol, map, cancelled_pairs, dropped)
-        } else {
-            let Some(grid) = self.grid.as_mut() else {
-                return Err(unsolved().into());
-            };
-            if grid.unfollowed.as_ref().is_none_or(|u| u.dropped != dropped) {
-                let solved = solved_for_quads(input, &grid.features.without(&dropped), &grid.options.for_quads(input, size), progress);
-                grid.unfollowed = Some(Unfollowed { dropped: dropped.clone(), solved });
-            }
-            let grid = self.grid.as_ref().ok_or_else(unsolved)?;
-            let (sol, quantizer, cancelled) = grid.quads_map(&pairs)?;
-            let again = match &grid.unfollowed {
-                Some(Unfollowed { solved: Some((solution, quantizer)), .. }) => quantizer.quantize(&solution.mesh, size, quantizing).ok().map(|m| (solution, m)),
-                _ => None,
-            };
-            match again {
-                Some((solution, again)) if again.report.folds() < map.report.folds() => (solution, again, 0, dropped),
-                _ if map.report.passes_skipped => {
-                    let full = quantizer.quantize(&sol.mesh, size, quantizing).map_err(|e| JsError::new(&e.to_string()))?;
-                    (sol, if full.report.folds() <= map.report.folds() { full } else { map }, cancelled, FeatureSet::none(input))
-                }
-                _ => (sol, map, cancelled, FeatureSet::none(input)),
-            }
-        };
+        let mapped = grid.map(input, size, &QuantizeOptions::default(), &mut solve_progress(progress), quantizing);
+        let GridMapped { solution: sol, map, dropped_features: dropped, cancelled_pairs } = mapped.map_err(|e| JsError::new(&e.to_string()))?;
         notify(progress, "quad extraction", 0, 0, None);
         let quad_mesh = extract_quads_along(&sol.mesh, &sol.features, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
-        // Every feature asked for, the dropped ones too.
-        let requested = &self.grid.as_ref().ok_or_else(unsolved)?.features;
-        let sharp = sol.solved_edges_of(requested);
+        let sharp = sol.solved_edges_of(&requested);
         let report = check_quads(&sol.mesh, &quad_mesh, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
         let uv: Vec<f32> = sol.input_corner_values(input, &map.uv).iter().flat_map(|p| p.map(|c| c as f32)).collect();
         let positions: Vec<f32> = quad_mesh.positions.iter().flat_map(|p| p.map(|c| c as f32)).collect();

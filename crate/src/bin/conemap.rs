@@ -655,7 +655,8 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
         // grid map folds) counts as quantization time.
         let bar = ProgressLine::new(args);
         let quantize = QuantizeOptions { retry_wound: true, ..QuantizeOptions::default() };
-        let mapped = conemap::pipeline::grid_map(&input_file.mesh, &features, &options, solution, size, &quantize, &mut |p| bar.solve(p), &mut |_, _| {});
+        let long_edges = conemap::pipeline::LongEdges::RefineWhereFolded;
+        let mapped = conemap::pipeline::grid_map(&input_file.mesh, &features, &options, solution, size, &quantize, long_edges, &mut |p| bar.solve(p), &mut |_, _| {});
         bar.finish();
         let mapped = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
         dropped_features = mapped.dropped_features.len();
@@ -737,7 +738,6 @@ fn grid_option(args: &Args, flag: &str) -> Result<Option<GridSize>, Failure> {
     }
 }
 
-/// The integer-grid map of `solution` for grid size `size`.
 /// The note on the feature edges a grid map was solved without
 /// ([`conemap::pipeline::grid_map`]), if any.
 fn print_dropped_features(dropped: usize) {

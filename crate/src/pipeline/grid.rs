@@ -1,108 +1,308 @@
-//! The integer-grid map of a solved map ([`crate::param::quantize`]), solved again
-//! on a finer mesh where the input's long edges leave the grid map folded,
-//! and without the feature curves the grid is too coarse to follow where
-//! they fold it.
+//! The integer-grid map of a solved map ([`crate::param::quantize`]) and
+//! the solves it may need again: on a finer mesh where the input's long
+//! edges are too coarse for the grid, with the grid's close opposite cones
+//! cancelled, and without the feature curves the grid is too coarse to
+//! follow where they fold it. [`GridStage`] keeps those solves for the next
+//! grid size (the page's quad-count slider); [`grid_map`] is one request.
 
-use super::{long_edges_refine, quad_length, Solution, SolveOptions, SolveProgress};
+use super::{long_edges_refine, quad_length, solve, RefineOptions, Solution, SolveOptions, SolveProgress};
+use crate::cones;
 use crate::features::{finer_than_grid, FeatureSet};
 use crate::mesh::TriMesh;
-use crate::param::quantize::{GridSize, IntegerGridMap, QuantizeError, QuantizeOptions};
+use crate::param::quantize::{GridSize, IntegerGridMap, QuantizeError, QuantizeOptions, Quantizer};
 
-/// An integer-grid map and the solution it quantizes (the one given to
-/// [`grid_map`], or the one solved again on the refinement of the input or
-/// without the features in `dropped_features`).
-pub struct GridMapped<'a> {
-    pub solution: Solution<'a>,
+/// An integer-grid map and the solution it quantizes: the one solved first,
+/// or one solved again (on the refinement of the input, with
+/// `cancelled_pairs` cone pairs cancelled, or without `dropped_features`).
+/// `S` is the solution or a reference to it.
+pub struct GridMapped<S> {
+    pub solution: S,
     pub map: IntegerGridMap,
     /// The input's feature edges the map was solved without
     /// ([`finer_than_grid`]); empty where every feature was kept.
     pub dropped_features: FeatureSet,
+    /// Opposite cone pairs of the first solve cancelled for this grid
+    /// ([`SolveOptions::for_quads`]); 0 where the map solved without
+    /// `dropped_features` is used (that solve cancels its own, uncounted).
+    pub cancelled_pairs: usize,
 }
 
-/// The integer-grid map of `solution` (solved on `mesh` with `features` and
-/// `options`) for `size`. Where it folds (flipped triangles or vertices it
-/// winds around) and `mesh` has edges longer than a quad mesh of `size`
-/// keeps ([`long_edges_refine`]: a low-poly CAD export), the map is solved
-/// again on that refinement and the grid map that folds less is kept (an
-/// extruded 12-point star with a bore, 288 faces, at 2 000-4 000 cells: 2-3
-/// flipped triangles on the input's, none on the refinement's). A failure
-/// of that second solve or quantization keeps the first map.
-///
-/// Where the map kept still folds and some feature curves are finer than
-/// the grid ([`finer_than_grid`]: short dangling branches and small
-/// loops, whose corner cones the rounding must put on grid points a cell
-/// apart), the map is solved again without them and kept if it folds less
-/// (teapot with creases above 60° at 3 000 quads: the map winds around 6
-/// vertices with the spout's lip, none without it). A map that follows
-/// every feature wins ties. With such curves, the first rounding stops
-/// after its plain pass where that leaves a hopeless map
-/// ([`QuantizeOptions::plain_only_if_hopeless`]: bff-face with creases
-/// above 60° at 1 000 quads, about 500 -> 67 s for the same quads; cow at
-/// 3 000, 103 -> 64 s), and runs its other passes only where the map
-/// without them folds no less.
-/// `solve_progress` reports the other solves, `progress` each quantization.
-pub fn grid_map<'a>(
-    mesh: &'a TriMesh,
-    features: &'a FeatureSet,
+/// When a map solved on a mesh with edges longer than the grid wants
+/// ([`long_edges_refine`]: a low-poly CAD export) is solved again on its
+/// refinement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LongEdges {
+    /// Before the first quantization: a quad mesh wants vertices where its
+    /// quads bend.
+    RefineFirst,
+    /// Only where the grid map folds, keeping the map that folds less: a
+    /// UV map keeps the input's triangles where it can (an extruded
+    /// 12-point star with a bore, 288 faces, at 2 000-4 000 cells: 2-3
+    /// flipped triangles on the input's, none on the refinement's).
+    RefineWhereFolded,
+}
+
+/// A solved map kept for integer-grid maps of any size, with the maps
+/// solved again for earlier sizes (each kept while later sizes ask for the
+/// same thing, so that moving a quad-count slider re-runs only the
+/// quantization).
+pub struct GridStage {
+    /// The map solved first (or on the refinement of the input, see [`LongEdges`]).
+    base: Solved,
+    /// The solve's features and settings, as solved (the low-poly
+    /// fallback's maximum edge length included), to solve again with.
+    features: FeatureSet,
+    options: SolveOptions,
+    long_edges: LongEdges,
+    /// The map solved again with these cut-vertex pairs of `base` cancelled.
+    paired: Option<Resolved<Vec<(u32, u32)>>>,
+    /// The map solved again without these feature edges.
+    unfollowed: Option<Resolved<FeatureSet>>,
+}
+
+/// A map and its quantizer (set up on first use).
+struct Solved {
+    solution: Solution<'static>,
+    quantizer: Option<Quantizer>,
+}
+
+/// A map solved again for `key`; `None` where that solve failed (not tried
+/// again for the same key).
+struct Resolved<K> {
+    key: K,
+    solved: Option<Solved>,
+}
+
+/// Which of a stage's maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    Base,
+    Paired,
+    Unfollowed,
+}
+
+impl Solved {
+    fn new(solution: Solution<'static>) -> Solved {
+        Solved { solution, quantizer: None }
+    }
+
+    /// `solution`'s integer-grid map for `size`, its quantizer set up first if need be.
+    fn quantize(&mut self, size: GridSize, options: &QuantizeOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<IntegerGridMap, QuantizeError> {
+        if self.quantizer.is_none() {
+            self.quantizer = Some(self.solution.quantizer()?);
+        }
+        let quantizer = self.quantizer.as_ref().expect("set up above");
+        quantizer.quantize_with(&self.solution.mesh, size, options, progress)
+    }
+}
+
+/// A candidate map: where it came from, the map, the features it dropped.
+struct Candidate {
+    source: Source,
+    map: IntegerGridMap,
+    dropped: FeatureSet,
+}
+
+impl GridStage {
+    /// The stage of `solution`, solved with `features` and `options`.
+    pub fn new(solution: Solution<'_>, features: FeatureSet, options: SolveOptions, long_edges: LongEdges) -> GridStage {
+        // As solved: a low-poly fallback's edge length is not asked again.
+        let options = SolveOptions { refine: solution.refine_options, ..options };
+        GridStage { base: Solved::new(solution.into_owned()), features, options, long_edges, paired: None, unfollowed: None }
+    }
+
+    /// The map solved first (or on the refinement of the input).
+    pub fn solution(&self) -> &Solution<'static> {
+        &self.base.solution
+    }
+
+    /// The features asked for (every one, the dropped ones too).
+    pub fn features(&self) -> &FeatureSet {
+        &self.features
+    }
+
+    /// The integer-grid map for `size` of the stage's map, solved on `input`
+    /// (the mesh the stage's solve was given), and what it was solved again
+    /// for:
+    /// 1. a mesh with edges longer than the grid wants is solved again on
+    ///    its refinement ([`LongEdges`]; where that solve fails, the map
+    ///    solved first is used and the refinement not asked again);
+    /// 2. where the grid puts opposite cones closer than
+    ///    [`cones::GRID_PAIR_CELLS`] cells and the map was not solved for
+    ///    them, it is solved again with those pairs cancelled
+    ///    ([`SolveOptions::for_quads`]; where the rounding kept such a pair
+    ///    it put it on one grid point or folded the cells between);
+    /// 3. where the map still folds (flipped triangles or vertices it winds
+    ///    around) and some feature curves are finer than the grid
+    ///    ([`finer_than_grid`]: short dangling branches and small loops,
+    ///    whose corner cones the rounding must put on grid points a cell
+    ///    apart), it is solved again without them and kept if it folds less
+    ///    (teapot with creases above 60° at 3 000 quads: the map winds
+    ///    around 6 vertices with the spout's lip, none without it). A map
+    ///    that follows every feature wins ties. With such curves the first
+    ///    rounding stops after its plain pass where that leaves a hopeless
+    ///    map ([`QuantizeOptions::plain_only_if_hopeless`]: bff-face with
+    ///    creases above 60° at 1 000 quads, about 500 -> 67 s for the same
+    ///    quads), and runs its other passes only where the map without them
+    ///    folds no less.
+    ///
+    /// A failed solve in 2 or 3 keeps the map without it. Errors: the
+    /// quantization's, of the map solved first. `solve_progress` reports
+    /// the solves, `progress` each quantization.
+    pub fn map(
+        &mut self,
+        input: &TriMesh,
+        size: GridSize,
+        quantize: &QuantizeOptions,
+        solve_progress: &mut dyn FnMut(SolveProgress),
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<GridMapped<&Solution<'static>>, QuantizeError> {
+        // 1. The refinement, before any rounding.
+        if self.long_edges == LongEdges::RefineFirst {
+            if let Some(refine) = long_edges_refine(input, &self.options.refine, Some(size)) {
+                if let Some(solved) = self.solve_again(input, &self.features, refine, None, solve_progress) {
+                    self.replace_base(solved);
+                }
+                self.options.refine = refine;
+            }
+        }
+        // 2. Close cone pairs cancelled; with curves to drop, a hopeless
+        // first rounding stops after its plain pass.
+        let source = self.pair_cancelled(input, size, solve_progress);
+        let dropped = finer_than_grid(input, &self.features, quad_length(input, size));
+        let first = QuantizeOptions { plain_only_if_hopeless: !dropped.is_empty(), ..*quantize };
+        let map = self.quantize(source, size, &first, progress)?;
+        let mut best = Candidate { source, map, dropped: FeatureSet::none(input) };
+        // 1. The refinement, where the map folds.
+        if best.map.report.folds() > 0 && self.long_edges == LongEdges::RefineWhereFolded {
+            if let Some(refine) = long_edges_refine(input, &self.options.refine, Some(size)) {
+                self.options.refine = refine;
+                let again = self.solve_again(input, &self.features, refine, Some(size), solve_progress);
+                if let Some(mut solved) = again {
+                    if let Ok(map) = solved.quantize(size, quantize, progress) {
+                        if map.report.folds() < best.map.report.folds() {
+                            self.replace_base(solved);
+                            best = Candidate { source: Source::Base, map, dropped: FeatureSet::none(input) };
+                        }
+                    }
+                }
+            }
+        }
+        // 3. Without the curves finer than the grid, where the map folds.
+        if best.map.report.folds() > 0 && !dropped.is_empty() {
+            if self.unfollowed.as_ref().is_none_or(|u| u.key != dropped) {
+                let solved = self.solve_again(input, &self.features.without(&dropped), self.options.refine, Some(size), solve_progress);
+                self.unfollowed = Some(Resolved { key: dropped.clone(), solved });
+            }
+            if let Ok(map) = self.quantize(Source::Unfollowed, size, quantize, progress) {
+                if map.report.folds() < best.map.report.folds() {
+                    best = Candidate { source: Source::Unfollowed, map, dropped };
+                }
+            }
+        }
+        // A stopped rounding kept after all runs in full.
+        if best.map.report.passes_skipped {
+            let map = self.quantize(best.source, size, quantize, progress)?;
+            // Every pass includes the plain one: no worse, and complete.
+            if map.report.folds() <= best.map.report.folds() {
+                best.map = map;
+            }
+        }
+        let cancelled_pairs = match (best.source, &self.paired) {
+            (Source::Paired, Some(p)) => p.key.len(),
+            _ => 0,
+        };
+        let solution = &self.solved(best.source).expect("a candidate's map exists").solution;
+        Ok(GridMapped { solution, map: best.map, dropped_features: best.dropped, cancelled_pairs })
+    }
+
+    /// The map to round for `size` (step 2 of [`Self::map`]): the map solved
+    /// again with the grid's close opposite cone pairs cancelled (solved
+    /// now unless the last such request had the same pairs), or the base
+    /// map where there are none, the base was solved for them, or that
+    /// solve failed.
+    fn pair_cancelled(&mut self, input: &TriMesh, size: GridSize, solve_progress: &mut dyn FnMut(SolveProgress)) -> Source {
+        let distance = cones::GRID_PAIR_CELLS * quad_length(input, size);
+        if self.options.cones.min_pair_distance >= distance {
+            return Source::Base;
+        }
+        let pairs = self.base.solution.placement.close_pairs(distance);
+        if pairs.is_empty() {
+            return Source::Base;
+        }
+        if self.paired.as_ref().is_none_or(|p| p.key != pairs) {
+            let solved = self.solve_again(input, &self.features, self.options.refine, Some(size), solve_progress);
+            self.paired = Some(Resolved { key: pairs, solved });
+        }
+        match &self.paired {
+            Some(Resolved { solved: Some(_), .. }) => Source::Paired,
+            _ => Source::Base,
+        }
+    }
+
+    /// `input` solved again with `features`, the stage's settings with
+    /// `refine`, and (for a grid) its close cone pairs cancelled; `None`
+    /// where that fails.
+    fn solve_again(
+        &self,
+        input: &TriMesh,
+        features: &FeatureSet,
+        refine: RefineOptions,
+        grid: Option<GridSize>,
+        solve_progress: &mut dyn FnMut(SolveProgress),
+    ) -> Option<Solved> {
+        let mut options = SolveOptions { refine, ..self.options };
+        if let Some(grid) = grid {
+            options = options.for_quads(input, grid);
+        }
+        let solution = solve(input, features, &options, solve_progress).ok()?;
+        Some(Solved::new(solution.into_owned()))
+    }
+
+    /// `solved` as the base map; the maps solved again from the old one go.
+    fn replace_base(&mut self, solved: Solved) {
+        self.base = solved;
+        self.paired = None;
+        self.unfollowed = None;
+    }
+
+    fn solved(&self, source: Source) -> Option<&Solved> {
+        match source {
+            Source::Base => Some(&self.base),
+            Source::Paired => self.paired.as_ref()?.solved.as_ref(),
+            Source::Unfollowed => self.unfollowed.as_ref()?.solved.as_ref(),
+        }
+    }
+
+    /// The integer-grid map of the map `source` (an error where it was not solved).
+    fn quantize(&mut self, source: Source, size: GridSize, options: &QuantizeOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<IntegerGridMap, QuantizeError> {
+        let solved = match source {
+            Source::Base => Some(&mut self.base),
+            Source::Paired => self.paired.as_mut().and_then(|p| p.solved.as_mut()),
+            Source::Unfollowed => self.unfollowed.as_mut().and_then(|u| u.solved.as_mut()),
+        };
+        let solved = solved.ok_or(QuantizeError::Mismatch { what: "a map that was not solved" })?;
+        solved.quantize(size, options, progress)
+    }
+}
+
+/// The integer-grid map of `solution` (solved on `mesh` with `features`
+/// and `options`) for `size`, as [`GridStage::map`] with `long_edges`, for
+/// a caller that asks once.
+#[allow(clippy::too_many_arguments)]
+pub fn grid_map(
+    mesh: &TriMesh,
+    features: &FeatureSet,
     options: &SolveOptions,
-    solution: Solution<'a>,
+    solution: Solution<'_>,
     size: GridSize,
     quantize: &QuantizeOptions,
+    long_edges: LongEdges,
     solve_progress: &mut dyn FnMut(SolveProgress),
     progress: &mut dyn FnMut(usize, usize),
-) -> Result<GridMapped<'a>, QuantizeError> {
-    // With curves to drop, a hopeless first rounding stops after its plain
-    // pass (and runs in full below only if dropping them does not help).
-    let dropped = finer_than_grid(mesh, features, quad_length(mesh, size));
-    let first = QuantizeOptions { plain_only_if_hopeless: !dropped.is_empty(), ..*quantize };
-    let map = solution.quantizer()?.quantize_with(&solution.mesh, size, &first, progress)?;
-    let mut best = GridMapped { solution, map, dropped_features: FeatureSet::none(mesh) };
-    if best.map.report.folds() == 0 {
-        return Ok(best);
-    }
-    let mut options = *options;
-    if let Some(refine) = long_edges_refine(mesh, &options.refine, Some(size)) {
-        options.refine = refine;
-        if let Some(again) = solve_and_quantize(mesh, features, &options, size, quantize, solve_progress, progress) {
-            keep_fewer_folds(&mut best, again);
-        }
-    }
-    if best.map.report.folds() > 0 && !dropped.is_empty() {
-        let kept = features.without(&dropped);
-        if let Some(again) = solve_and_quantize(mesh, &kept, &options, size, quantize, solve_progress, progress) {
-            let solution = again.solution.into_owned();
-            keep_fewer_folds(&mut best, GridMapped { solution, map: again.map, dropped_features: dropped });
-        }
-    }
-    if best.map.report.passes_skipped {
-        let map = best.solution.quantizer()?.quantize_with(&best.solution.mesh, size, quantize, progress)?;
-        // Every pass includes the plain one: no worse, and complete.
-        if map.report.folds() <= best.map.report.folds() {
-            best.map = map;
-        }
-    }
-    Ok(best)
-}
-
-/// The grid map of `mesh` solved with `features` and `options` (`None`
-/// where the solve or the quantization fails).
-fn solve_and_quantize<'a>(
-    mesh: &'a TriMesh,
-    features: &'a FeatureSet,
-    options: &SolveOptions,
-    size: GridSize,
-    quantize: &QuantizeOptions,
-    solve_progress: &mut dyn FnMut(SolveProgress),
-    progress: &mut dyn FnMut(usize, usize),
-) -> Option<GridMapped<'a>> {
-    let solution = super::solve(mesh, features, options, solve_progress).ok()?;
-    let map = solution.quantizer().ok()?.quantize_with(&solution.mesh, size, quantize, progress).ok()?;
-    Some(GridMapped { solution, map, dropped_features: FeatureSet::none(mesh) })
-}
-
-/// `candidate` in place of `best` where its map has fewer [`crate::param::quantize::QuantizeReport::folds`].
-fn keep_fewer_folds<'a>(best: &mut GridMapped<'a>, candidate: GridMapped<'a>) {
-    if candidate.map.report.folds() < best.map.report.folds() {
-        *best = candidate;
-    }
+) -> Result<GridMapped<Solution<'static>>, QuantizeError> {
+    let mut stage = GridStage::new(solution, features.clone(), *options, long_edges);
+    let GridMapped { solution, map, dropped_features, cancelled_pairs } = stage.map(mesh, size, quantize, solve_progress, progress)?;
+    // (A copy of the mesh and map: milliseconds beside the solve.)
+    Ok(GridMapped { solution: solution.clone(), map, dropped_features, cancelled_pairs })
 }

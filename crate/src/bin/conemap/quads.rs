@@ -34,9 +34,10 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     // Solves again without the feature curves finer than the grid where
     // they fold the map (counted as quantization time).
     let bar = ProgressLine::new(args);
-    let mapped = conemap::pipeline::grid_map(&input.mesh, &features, &options, solution, grid, &QuantizeOptions::default(), &mut |p| bar.solve(p), &mut |_, _| {});
+    let long_edges = conemap::pipeline::LongEdges::RefineFirst;
+    let mapped = conemap::pipeline::grid_map(&input.mesh, &features, &options, solution, grid, &QuantizeOptions::default(), long_edges, &mut |p| bar.solve(p), &mut |_, _| {});
     bar.finish();
-    let conemap::pipeline::GridMapped { solution, map, dropped_features } = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let conemap::pipeline::GridMapped { solution, map, dropped_features, .. } = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let quantize_seconds = clock.lap();
     let quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let extract = clock.lap();
