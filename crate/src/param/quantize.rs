@@ -632,7 +632,7 @@ impl Quantizer {
         let grid = self.grid_start(s);
         let stiff = self.stiff_faces(&grid.x0);
         let plain_fit = Fit::new(&self.elements, &stiff, 1.0);
-        let mut plain = self.round_and_polish(&plain_fit, &grid, Pass::default(), progress)?.expect("a plain pass");
+        let mut plain = self.round_and_polish(&plain_fit, &grid, Pass::default(), None, progress)?.expect("a plain pass");
         if options.plain_only_if_hopeless && plain.faults() + plain.wound > HOPELESS_PLACES {
             plain.passes_skipped = true;
             return Ok((plain, s));
@@ -662,7 +662,7 @@ impl Quantizer {
         // small parts have fine cells, 0.166 against 0.176).
         let graded_first = self.elements.len() as f64 > FULL_BUDGET_FACES && self.rings(1.0, s) >= GRADED_FIRST_RINGS;
         let graded_pass = |best: &mut Option<(Rounded, f64)>, progress: &mut dyn FnMut(usize, usize)| -> Result<(), QuantizeError> {
-            let rounded = self.round_and_polish(&self.graded_fit(&grid.x0), &grid, Pass::default(), progress)?.expect("a graded pass");
+            let rounded = self.round_and_polish(&self.graded_fit(&grid.x0), &grid, Pass::default(), bound(best), progress)?.expect("a graded pass");
             keep_better(best, rounded, s);
             Ok(())
         };
@@ -676,7 +676,7 @@ impl Quantizer {
             if !is_bad(&best) && !mended {
                 break;
             }
-            let rounded = self.round_and_polish(&Fit::new(&self.elements, &stiff, weight), &grid, Pass::default(), progress)?.expect("a stiff pass");
+            let rounded = self.round_and_polish(&Fit::new(&self.elements, &stiff, weight), &grid, Pass::default(), bound(&best), progress)?.expect("a stiff pass");
             keep_better(&mut best, rounded, s);
         }
         if !held_first && few && is_bad(&best) {
@@ -695,7 +695,7 @@ impl Quantizer {
             let (held, best_pass) = (Pass { hold: b.separations_held > 0, widen: false }, b.pass);
             let retried = self.grid_start(s * factor);
             for pass in [held, best_pass].into_iter().take(if best_pass.widen { 2 } else { 1 }) {
-                match self.round_and_polish(&plain_fit, &retried, pass, progress)? {
+                match self.round_and_polish(&plain_fit, &retried, pass, bound(&best), progress)? {
                     Some(rounded) if pass.widen => keep_dominant(&mut best, rounded, retried.s),
                     Some(rounded) => keep_better(&mut best, rounded, retried.s),
                     None => {}
@@ -713,11 +713,11 @@ impl Quantizer {
     /// as dependent) and its map is bad, the widened one: another trajectory
     /// of the rounding, kept only if it dominates ([`keep_dominant`]).
     fn held_passes(&self, fit: &Fit, grid: &GridStart, best: &mut Option<(Rounded, f64)>, progress: &mut dyn FnMut(usize, usize)) -> Result<(), QuantizeError> {
-        let rounded = self.round_and_polish(fit, grid, Pass { hold: true, widen: false }, progress)?.expect("a held pass");
+        let rounded = self.round_and_polish(fit, grid, Pass { hold: true, widen: false }, bound(best), progress)?.expect("a held pass");
         let widen = rounded.held_dropped > 0 && rounded.faults() + rounded.wound > 0;
         keep_better(best, rounded, grid.s);
         if widen {
-            if let Some(rounded) = self.round_and_polish(fit, grid, Pass { hold: true, widen: true }, progress)? {
+            if let Some(rounded) = self.round_and_polish(fit, grid, Pass { hold: true, widen: true }, bound(best), progress)? {
                 keep_dominant(best, rounded, grid.s);
             }
         }
@@ -898,6 +898,13 @@ struct GridStart {
     targets: Vec<[[f64; 2]; 2]>,
     s: f64,
     rules: SizeRules,
+}
+
+/// The [`Quantizer::badness`] of the best map so far where it is bad: the
+/// bound of the next pass's polish ([`Quantizer::polish`]).
+fn bound(best: &Option<(Rounded, f64)>) -> Option<usize> {
+    let badness = |r: &Rounded| r.collapsed + polish::WOUND_WEIGHT * r.wound;
+    best.as_ref().map(|(b, _)| badness(b)).filter(|&b| b > 0)
 }
 
 /// Keeps the better of `best` and `candidate` (rounded at grid length

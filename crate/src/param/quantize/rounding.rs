@@ -45,7 +45,9 @@ impl Quantizer {
     /// violated ([`HeldApart`]); with `pass.widen` too, held rows are
     /// widened first ([`Self::widen_held`]), and the pass is not run
     /// (`None`) where that widens nothing: it would repeat the held pass.
-    pub(super) fn round_and_polish(&self, fit: &Fit, grid: &GridStart, pass: Pass, progress: &mut dyn FnMut(usize, usize)) -> Result<Option<Rounded>, QuantizeError> {
+    /// `bound`: the badness of the best map of the earlier passes where it
+    /// is bad; a map far worse is not untangled ([`Self::polish`]).
+    pub(super) fn round_and_polish(&self, fit: &Fit, grid: &GridStart, pass: Pass, bound: Option<usize>, progress: &mut dyn FnMut(usize, usize)) -> Result<Option<Rounded>, QuantizeError> {
         let GridStart { x0, targets, s, rules } = grid;
         let s = *s;
         let separations = &rules.separations;
@@ -159,7 +161,7 @@ impl Quantizer {
         let mut polish = Polished::default();
         let mut rounded_bad = false;
         if let Some(mut moved_system) = system {
-            polish = self.polish(x.clone(), &moved_system, targets, s, stiffen)?;
+            polish = self.polish(x.clone(), &moved_system, targets, s, stiffen, bound)?;
             rounded_bad = polish.rounded_bad > 0;
             let rounded = std::mem::replace(&mut x, std::mem::take(&mut polish.x));
             if polish.bad > 0 && UNCOLLAPSE_TRIALS > 0 {
@@ -174,7 +176,9 @@ impl Quantizer {
                     separations,
                 )?;
                 if moves > 0 {
-                    let mut moved = self.polish(moved_x, &moved_system, targets, s, stiffen)?;
+                    // Kept only if less bad than the map without the moves.
+                    let bound = Some(bound.map_or(polish.bad, |b| b.min(polish.bad)));
+                    let mut moved = self.polish(moved_x, &moved_system, targets, s, stiffen, bound)?;
                     if moved.bad < polish.bad {
                         (x, values, moved_integers) = (std::mem::take(&mut moved.x), moved_values, moves);
                         polish = moved;
