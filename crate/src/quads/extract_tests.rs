@@ -3,7 +3,7 @@
 //! components, and invalid maps.
 
 use super::{extract_quads, ExtractError, ExtractOptions};
-use crate::quads::{QuadDefect, QuadMesh};
+use crate::quads::{QuadDefect, QuadMesh, SurfacePoint};
 use crate::TriMesh;
 use std::collections::HashMap;
 
@@ -871,4 +871,29 @@ fn holes_that_cut_the_quads_in_two_are_joined() {
         let z: Vec<f64> = quad.iter().map(|&v| q.positions[v as usize][2]).collect();
         assert!(z.iter().filter(|&&z| z == 0.25).count() == 2 && z.iter().filter(|&&z| z == 0.75).count() == 2, "{z:?}");
     }
+}
+
+/// A cube of six quads with a pillow (two quads over the same four
+/// vertices, in opposite orders) glued along one of its edges: removing
+/// the pillow leaves the closed, manifold cube with its own corners and
+/// unit squares, and one defect saying where.
+#[test]
+fn pillows_glued_to_the_mesh_are_removed() {
+    let cube = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
+    let pillow = [[0, 1, 9, 8], [8, 9, 1, 0]];
+    let quads: Vec<[u32; 4]> = cube.iter().chain(&pillow).copied().collect();
+    let unit = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let at = SurfacePoint { face: 7, bary: [1.0, 0.0, 0.0] };
+    let mut q = QuadMesh { positions: vec![[0.0; 3]; 10], locations: vec![at; 10], uv: unit.repeat(quads.len()), quads, defects: Vec::new() };
+    let before = topology(&q);
+    assert!(!before.manifold, "the pillow's edge (0, 1) has four quads");
+    super::drop_pillows(&mut q);
+    super::drop_unreferenced(&mut q);
+    assert_eq!(q.quads, cube.to_vec());
+    let after = topology(&q);
+    assert!(after.manifold);
+    assert_eq!((after.euler, after.boundary_loops, after.unused_vertices, q.n_vertices()), (2, 0, 0, 8));
+    assert_unit_squares(&q);
+    assert_eq!(q.defects.len(), 1);
+    assert_eq!(q.defects[0].face, 7);
 }
