@@ -193,21 +193,7 @@ fn drop_pillows(quads: &mut QuadMesh) {
             quads.defects.push(QuadDefect { face, what: "two quads over the same four vertices closed on each other; both removed".into() });
         }
     }
-    if !dropped.contains(&true) {
-        return;
-    }
-    let mut kept = 0;
-    for i in 0..quads.quads.len() {
-        if !dropped[i] {
-            quads.quads[kept] = quads.quads[i];
-            for k in 0..4 {
-                quads.uv[4 * kept + k] = quads.uv[4 * i + k];
-            }
-            kept += 1;
-        }
-    }
-    quads.quads.truncate(kept);
-    quads.uv.truncate(4 * kept);
+    quads.remove_quads(&dropped);
 }
 
 /// Removes the vertices no quad uses (the tip of an isoline traced out and

@@ -57,6 +57,23 @@ pub struct QuadDefect {
 }
 
 impl QuadMesh {
+    /// Removes the quads `q` with `remove[q]` and their corner UVs, keeping
+    /// the others in order (the vertices stay).
+    pub(crate) fn remove_quads(&mut self, remove: &[bool]) {
+        let mut kept = 0;
+        for q in 0..self.quads.len() {
+            if !remove[q] {
+                self.quads[kept] = self.quads[q];
+                for k in 0..4 {
+                    self.uv[4 * kept + k] = self.uv[4 * q + k];
+                }
+                kept += 1;
+            }
+        }
+        self.quads.truncate(kept);
+        self.uv.truncate(4 * kept);
+    }
+
     pub fn n_vertices(&self) -> usize {
         self.positions.len()
     }

@@ -269,18 +269,7 @@ fn open_non_manifold(mesh: &TriMesh, quads: &mut QuadMesh) -> (usize, u32) {
             let q = remove.iter().position(|&r| r).unwrap_or(0);
             face = quads.locations[quads.quads[q][0] as usize].face;
         }
-        let mut k = 0;
-        for q in 0..quads.n_quads() {
-            if !remove[q] {
-                quads.quads[k] = quads.quads[q];
-                for i in 0..4 {
-                    quads.uv[4 * k + i] = quads.uv[4 * q + i];
-                }
-                k += 1;
-            }
-        }
-        quads.quads.truncate(k);
-        quads.uv.truncate(4 * k);
+        quads.remove_quads(&remove);
         removed += count;
     }
     (removed, face)
