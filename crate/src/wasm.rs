@@ -290,7 +290,7 @@ impl MeshSession {
         let fail = |e: SolveError| solve_error(&e);
         let sol = stage.finish(mesh, &features, placed, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
-        // As solved: a low-poly fallback's edge length is not asked again.
+        // (The stage keeps the settings as solved: a low-poly fallback's edge length is not asked again.)
         self.grid = Some(GridStage::new(sol.into_owned(), features, options, LongEdges::RefineFirst));
         Ok(result)
     }
