@@ -836,6 +836,11 @@ impl Rounded {
     fn faults(&self) -> usize {
         self.collapsed + self.periods_violated
     }
+
+    /// [`Quantizer::badness`] of the map, from its counts.
+    fn badness(&self) -> usize {
+        self.collapsed + polish::WOUND_WEIGHT * self.wound
+    }
 }
 
 /// The outcome of one [`Quantizer::round_and_polish`].
@@ -903,8 +908,7 @@ struct GridStart {
 /// The [`Quantizer::badness`] of the best map so far where it is bad: the
 /// bound of the next pass's polish ([`Quantizer::polish`]).
 fn bound(best: &Option<(Rounded, f64)>) -> Option<usize> {
-    let badness = |r: &Rounded| r.collapsed + polish::WOUND_WEIGHT * r.wound;
-    best.as_ref().map(|(b, _)| badness(b)).filter(|&b| b > 0)
+    best.as_ref().map(|(b, _)| b.badness()).filter(|&b| b > 0)
 }
 
 /// Keeps the better of `best` and `candidate` (rounded at grid length

@@ -111,11 +111,6 @@ impl GridStage {
         GridStage { base: Solved::new(solution.into_owned()), features, options, long_edges, paired: None, unfollowed: None }
     }
 
-    /// The map solved first (or on the refinement of the input).
-    pub fn solution(&self) -> &Solution<'static> {
-        &self.base.solution
-    }
-
     /// The features asked for (every one, the dropped ones too).
     pub fn features(&self) -> &FeatureSet {
         &self.features

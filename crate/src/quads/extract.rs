@@ -163,8 +163,9 @@ pub fn extract_quads_along(mesh: &TriMesh, features: &FeatureSet, uv: &[[f64; 2]
 }
 
 /// Removes every pair of quads over the same four vertices in opposite
-/// orders (a pillow: two faces closed on each other, which the repairs of
-/// a badly folded map can leave) and says where. Each of their edges loses
+/// orders (a pillow: two faces closed on each other) and says where. The
+/// hole filling ([`fill::fill_holes`]) made them on the case below (none
+/// existed before it; how it does is not known yet). Each of their edges loses
 /// two faces, so an edge a pillow made non-manifold gets its two others
 /// back, and no edge becomes a boundary that was not one: a jittered
 /// fandisk stretched 3 x 1 x 0.5 with creases above 60° at 3 000 quads
