@@ -47,28 +47,37 @@ fn cones_refines_where_the_features_need_it_as_solve_does() {
     assert_eq!(k, 4 * report["euler_characteristic"].as_i64().unwrap(), "Gauss-Bonnet on the refined mesh");
 }
 
+/// A `conemap quads` run on a shared mesh that succeeded: its scratch
+/// directory (remove it when done), the quad OBJ, stdout and the report.
+struct QuadsRun {
+    dir: std::path::PathBuf,
+    obj: std::path::PathBuf,
+    stdout: String,
+    report: serde_json::Value,
+}
+
+/// Runs `conemap quads` on `../shared/meshes/{mesh}.obj` with `args` (and
+/// `--quiet --report`) into a scratch directory named after `tag`.
+fn run_quads(mesh: &str, tag: &str, args: &[&str]) -> QuadsRun {
+    let input = format!("{}/../../shared/meshes/{mesh}.obj", env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("conemap-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (obj, report) = (dir.join(format!("{mesh}-quads.obj")), dir.join(format!("{mesh}-quads.json")));
+    let out = Command::new(env!("CARGO_BIN_EXE_conemap")).arg("quads").arg(input).arg("-o").arg(&obj).args(args).args(["--quiet", "--report"]).arg(&report).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    QuadsRun { dir, obj, stdout: String::from_utf8_lossy(&out.stdout).into_owned(), report }
+}
+
 /// `conemap quads` writes a pure-quad OBJ with grid UVs and a report whose
 /// figures agree with the file; `solve --grid` writes grid-unit UVs.
 #[test]
 fn quads_writes_a_quad_obj_and_its_report() {
     let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes/spot.obj");
-    let dir = std::env::temp_dir().join(format!("conemap-quads-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (obj, report) = (dir.join("spot-quads.obj"), dir.join("spot-quads.json"));
-    let out = Command::new(env!("CARGO_BIN_EXE_conemap"))
-        .arg("quads")
-        .arg(spot)
-        .arg("-o")
-        .arg(&obj)
-        .args(["--quads", "3000", "--quiet", "--report"])
-        .arg(&report)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let QuadsRun { dir, obj, report: json, .. } = run_quads("spot", "quads", &["--quads", "3000"]);
     let text = std::fs::read_to_string(&obj).unwrap();
     let faces: Vec<&str> = text.lines().filter(|l| l.starts_with("f ")).collect();
     assert!(faces.iter().all(|f| f.split_whitespace().count() == 5), "a face that is not a quad");
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(json["quads"]["quads"].as_u64().unwrap() as usize, faces.len());
     assert_eq!(json["quads"]["euler_characteristic"], 2);
     assert!((faces.len() as f64 / 3000.0 - 1.0).abs() < 0.1, "{} quads", faces.len());
@@ -96,14 +105,8 @@ fn quads_writes_a_quad_obj_and_its_report() {
 /// measure them.
 #[test]
 fn quads_say_which_features_the_grid_could_not_follow() {
-    let teapot = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes/teapot.obj");
-    let dir = std::env::temp_dir().join(format!("conemap-dropped-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (obj, report) = (dir.join("teapot-quads.obj"), dir.join("teapot-quads.json"));
-    let out = Command::new(env!("CARGO_BIN_EXE_conemap")).arg("quads").arg(teapot).arg("-o").arg(&obj).args(["--sharp", "60", "--quiet", "--report"]).arg(&report).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(String::from_utf8_lossy(&out.stdout).contains("solved without 4 feature edges"), "{}", String::from_utf8_lossy(&out.stdout));
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let QuadsRun { dir, stdout, report: json, .. } = run_quads("teapot", "dropped", &["--sharp", "60"]);
+    assert!(stdout.contains("solved without 4 feature edges"), "{stdout}");
     assert_eq!(json["dropped_feature_edges"], 4);
     assert_eq!(json["defects"].as_array().map(Vec::len), Some(0));
     assert!(json["quads"]["sharp_edges_checked"].as_u64().unwrap() >= 4);
