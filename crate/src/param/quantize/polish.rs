@@ -1,7 +1,7 @@
 //! The polish of a rounded map: local stiffening where the plain fit's
 //! rounding folds, the untangler under the integer rows (on patches around
 //! the folds of a large mesh: [`super::local`]), ARAP iterations, and where
-//! the map is still bad one-integer moves at the bad triangles
+//! the stiffened map is still bad one-integer moves at the bad triangles
 //! ([`Quantizer::uncollapse`]); and the measures of how bad a map is
 //! ([`Quantizer::badness`]).
 
@@ -21,9 +21,10 @@ const COLLAPSED_SHARE: f64 = 1e-6;
 /// Weight of a wound vertex in [`Quantizer::badness`].
 pub(super) const WOUND_WEIGHT: usize = 16;
 /// How many times worse ([`Quantizer::badness`]) than the best map of the
-/// rounding so far a map may be after its local stiffening for
-/// [`Quantizer::polish`] to untangle it; worse ones hold their folds with
-/// their integers. Fandisk >60° at 700 quads: the held and widened passes'
+/// rounding so far, or than the same rounding with its integers moved off
+/// the collapses ([`Quantizer::uncollapse`], polished first), a map may be
+/// after its local stiffening for [`Quantizer::polish_stiffened`] to
+/// untangle it; worse ones hold their folds with their integers. Fandisk >60° at 700 quads: the held and widened passes'
 /// 1 900 bad faces against the plain pass's 51 ended at 1 800-1 900, after
 /// 3-5 s of untangling each; cow at 700: the held, widened and graded
 /// passes' 980-1 900 against 32 ended at 64-650. The most a kept map was
@@ -77,28 +78,56 @@ impl Quantizer {
         }
     }
 
-    /// Where `x` is bad and with `stiffen`, starts from its least bad local
-    /// stiffening ([`Self::stiffen`]); untangles it under `system`'s rows
-    /// when it folds, then runs ARAP local/global iterations (eq. 4), each
-    /// step kept unless it makes the map worse by [`Self::badness`].
-    /// `bound`: the badness of the best map so far where that is bad; with
-    /// `stiffen`, a map more than [`HOPELESS_POLISH_FACTOR`] times worse
-    /// after its stiffening is returned as it is.
+    /// [`Self::stiffened`] and [`Self::polish_stiffened`]: the whole polish
+    /// of the rounded map `x`.
     pub(super) fn polish(
         &self,
-        mut x: Vec<f64>,
+        x: Vec<f64>,
         system: &RoundedSystem,
         targets: &[[[f64; 2]; 2]],
         s: f64,
         stiffen: bool,
         bound: Option<usize>,
     ) -> Result<Polished, QuantizeError> {
+        let start = self.stiffened(x, system, targets, s, stiffen)?;
+        self.polish_stiffened(start, system, targets, s, stiffen, bound)
+    }
+
+    /// The rounded map `x` as its polish starts: where it is bad and with
+    /// `stiffen`, its least bad local stiffening ([`Self::stiffen`]) under
+    /// `system`'s rows.
+    pub(super) fn stiffened(
+        &self,
+        x: Vec<f64>,
+        system: &RoundedSystem,
+        targets: &[[[f64; 2]; 2]],
+        s: f64,
+        stiffen: bool,
+    ) -> Result<Polished, QuantizeError> {
         let rounded_bad = self.badness(&x, s);
-        let mut bad = rounded_bad;
-        let mut stiffening = 0;
+        let (mut x, mut bad, mut stiffening) = (x, rounded_bad, 0);
         if bad > 0 && stiffen {
             (x, bad, stiffening) = self.stiffen(x, bad, system, targets, s)?;
         }
+        Ok(Polished { x, bad, rounded_bad, arap_iterations: 0, untangled: false, stiffening })
+    }
+
+    /// The rest of the polish of `start` ([`Self::stiffened`] with the same
+    /// `stiffen`): untangles it under `system`'s rows when it folds, then
+    /// runs ARAP local/global iterations (eq. 4), each step kept unless it
+    /// makes the map worse by [`Self::badness`]. `bound`: the badness of the
+    /// best map so far where that is bad; with `stiffen`, a map more than
+    /// [`HOPELESS_POLISH_FACTOR`] times worse is returned as it is.
+    pub(super) fn polish_stiffened(
+        &self,
+        start: Polished,
+        system: &RoundedSystem,
+        targets: &[[[f64; 2]; 2]],
+        s: f64,
+        stiffen: bool,
+        bound: Option<usize>,
+    ) -> Result<Polished, QuantizeError> {
+        let Polished { mut x, mut bad, rounded_bad, stiffening, .. } = start;
         let mut arap_iterations = 0;
         let mut untangled = false;
         if stiffen && bound.is_some_and(|b| bad > HOPELESS_POLISH_FACTOR * b) {
