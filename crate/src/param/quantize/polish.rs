@@ -33,7 +33,7 @@ pub(super) const WOUND_WEIGHT: usize = 16;
 /// more (cow at 700, weight 100: 1 102 to 32 against 128): always run.
 pub(super) const HOPELESS_POLISH_FACTOR: usize = 6;
 /// Integer moves tried against flipped or collapsed triangles, at most.
-pub(super) const UNCOLLAPSE_TRIALS: usize = 40;
+const UNCOLLAPSE_TRIALS: usize = 40;
 /// Unknowns of bad triangles whose sensitivities pick the integers
 /// [`Quantizer::uncollapse`] tries, at most per round.
 pub(super) const UNCOLLAPSE_PROBES: usize = 48;
@@ -257,6 +257,31 @@ impl Quantizer {
         Ok((x, bad, iterations))
     }
 
+    /// The rounded map `rounded` (integers `values`) with integers moved off
+    /// its collapses ([`Self::uncollapse`]) and polished ([`Self::polish`]
+    /// with `stiffen` and `bound`); `None` where no move was kept.
+    /// `system`'s rows are as given on return.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn polish_moved(
+        &self,
+        values: &[Option<i64>],
+        rounded: &[f64],
+        system: &mut RoundedSystem,
+        x0: &[f64],
+        targets: &[[[f64; 2]; 2]],
+        s: f64,
+        separations: &Separations,
+        stiffen: bool,
+        bound: Option<usize>,
+    ) -> Result<Option<Moved>, QuantizeError> {
+        let (rows, solution) = (system.b.clone(), system.x.clone());
+        let (mut values, mut x) = (values.to_vec(), rounded.to_vec());
+        let moves = self.uncollapse(&mut values, &mut x, system, x0, targets, s, separations)?;
+        let moved = if moves > 0 { Some(Moved { polish: self.polish(x, system, targets, s, stiffen, bound)?, values, moves }) } else { None };
+        (system.b, system.x) = (rows, solution);
+        Ok(moved)
+    }
+
     /// Where the rounded map has flipped or collapsed triangles or wound
     /// vertices, moves by one the integers that move their corners (found by
     /// adjoint solves as in [`Self::separate`], so a translation whose seam
@@ -438,6 +463,15 @@ impl Quantizer {
     pub(super) fn flipped(&self, x: &[f64]) -> usize {
         local::inverted_faces(&self.elements, x).len()
     }
+}
+
+/// A rounded map with integers moved off its collapses, polished
+/// ([`Quantizer::polish_moved`]).
+pub(super) struct Moved {
+    pub(super) polish: Polished,
+    pub(super) values: Vec<Option<i64>>,
+    /// Integers moved.
+    pub(super) moves: usize,
 }
 
 /// What [`Quantizer::polish`] made of a rounded map: the map, its

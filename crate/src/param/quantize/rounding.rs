@@ -8,7 +8,7 @@
 use super::super::separation::{HeldApart, Separation, Separations};
 use super::fit::{Fit, RoundedSystem};
 use super::forms::FormKind;
-use super::polish::{Polished, UNCOLLAPSE_TRIALS};
+use super::polish::Polished;
 use super::{GridStart, Pass, QuantizeError, Quantizer, Rounded, FULL_BUDGET_FACES, NEAR_INTEGER};
 
 /// Share of the remaining forms of a class rounded per batch.
@@ -152,15 +152,17 @@ impl Quantizer {
                 );
             }
         }
-        // The rounded map polished (untangled where it folds, then ARAP).
-        // Where its local stiffening leaves it bad, the integers are moved
-        // off the collapses ([`Self::uncollapse`]: it starts from the
-        // rounded map, not the polished one) and that map is polished first:
-        // its badness bounds the unmoved map's untangling, which on a coarse
+        // The rounded map polished (untangled where it folds, then ARAP);
+        // where it is bad, the same with integers moved off the collapses
+        // too ([`Self::polish_moved`]), keeping whichever ends less bad
+        // (ties to the unmoved map). For the plain fit's passes the moved
+        // map goes first, where the local stiffening leaves the map bad: its
+        // badness bounds the unmoved map's untangling, which on a coarse
         // grid often cannot mend the map (fandisk >60 at 1 000 quads: 1 173
         // bad faces, 10 s, ending at 754, against the moved map's 64 after
-        // 0.5 s). Whichever ends less bad is kept, ties to the unmoved map.
-        // The stiffer fits stiffen faces around singular points already.
+        // 0.5 s). The stiffer fits are polished whatever the bound (and
+        // stiffen faces around singular points already): their moved map
+        // comes after, only where the unmoved one stays bad.
         let stiffen = fit.stiff_weight == 1.0;
         let mut moved_integers = 0;
         let mut polish = Polished::default();
@@ -169,24 +171,22 @@ impl Quantizer {
             let start = self.stiffened(x.clone(), &system, targets, s, stiffen)?;
             rounded_bad = start.rounded_bad > 0;
             let mut moved = None;
-            if start.bad > 0 && UNCOLLAPSE_TRIALS > 0 {
-                let unmoved_rows = system.b.clone();
-                let (mut moved_values, mut moved_x) = (values.clone(), x.clone());
-                let moves = self.uncollapse(&mut moved_values, &mut moved_x, &mut system, x0, targets, s, separations)?;
-                if moves > 0 {
-                    moved = Some((self.polish(moved_x, &system, targets, s, stiffen, bound)?, moved_values, moves));
-                }
-                system.b = unmoved_rows;
+            if stiffen && start.bad > 0 {
+                moved = self.polish_moved(&values, &x, &mut system, x0, targets, s, separations, stiffen, bound)?;
             }
-            let bound = match &moved {
-                Some((m, _, _)) if m.bad > 0 => Some(bound.map_or(m.bad, |b| b.min(m.bad))),
+            let unmoved_bound = match &moved {
+                Some(m) if m.polish.bad > 0 => Some(bound.map_or(m.polish.bad, |b| b.min(m.polish.bad))),
                 _ => bound,
             };
-            polish = self.polish_stiffened(start, &system, targets, s, stiffen, bound)?;
+            let unmoved = self.polish_stiffened(start, &system, targets, s, stiffen, unmoved_bound)?;
+            if !stiffen && unmoved.bad > 0 {
+                moved = self.polish_moved(&values, &x, &mut system, x0, targets, s, separations, stiffen, bound)?;
+            }
+            polish = unmoved;
             x = std::mem::take(&mut polish.x);
-            if let Some((mut m, moved_values, moves)) = moved.filter(|(m, _, _)| m.bad < polish.bad) {
-                (x, values, moved_integers) = (std::mem::take(&mut m.x), moved_values, moves);
-                polish = m;
+            if let Some(mut m) = moved.filter(|m| m.polish.bad < polish.bad) {
+                (x, values, moved_integers) = (std::mem::take(&mut m.polish.x), m.values, m.moves);
+                polish = m.polish;
             }
         }
         let (collapsed, wound, distortion, separations_violated) = self.assess(&x, s, targets, separations);
