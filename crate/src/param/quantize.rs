@@ -33,7 +33,8 @@
 //! vertices, and [`Quantizer::widen_periods`] moves the integers that
 //! determine it.
 //!
-//! Then [`Quantizer::polish`]: where the plain fit's rounded map is bad,
+//! Then the polish ([`Quantizer::stiffened`], [`Quantizer::polish_stiffened`]):
+//! where the plain fit's rounded map is bad,
 //! the local stiffening of Bommes et al. 2009 (MIQ; [`Quantizer::stiffen`]:
 //! the fit weights near the bad faces raised by their error, re-solved a
 //! few times), which spreads the spike a rounded point drags the fit along
@@ -41,9 +42,11 @@
 //! where the map folds (on a large mesh on patches around the folds alone:
 //! [`local`]), and ARAP local/global iterations (eq. 4), each kept
 //! unless it makes the map worse by [`Quantizer::badness`] (flipped or
-//! collapsed triangles, wound vertices). Where the map is still bad,
+//! collapsed triangles, wound vertices). Where the map is bad,
 //! [`Quantizer::uncollapse`] moves the integers at the bad triangles by one
 //! and the moved map is polished too; the better of the two is returned.
+//! For the plain fit the moved map goes first, where the stiffening leaves
+//! the map bad, and its badness bounds the unmoved map's untangling.
 //!
 //! The fit weighs every face alike first. A rounded singular point then
 //! drags the fit along as a spike (the displacement of a point constraint
@@ -906,7 +909,7 @@ struct GridStart {
 }
 
 /// The [`Quantizer::badness`] of the best map so far where it is bad: the
-/// bound of the next pass's polish ([`Quantizer::polish`]).
+/// bound of the next pass's polish ([`Quantizer::polish_stiffened`]).
 fn bound(best: &Option<(Rounded, f64)>) -> Option<usize> {
     best.as_ref().map(|(b, _)| b.badness()).filter(|&b| b > 0)
 }

@@ -33,7 +33,7 @@ pub(super) const WOUND_WEIGHT: usize = 16;
 /// more (cow at 700, weight 100: 1 102 to 32 against 128): always run.
 pub(super) const HOPELESS_POLISH_FACTOR: usize = 6;
 /// Integer moves tried against flipped or collapsed triangles, at most.
-const UNCOLLAPSE_TRIALS: usize = 40;
+pub(super) const UNCOLLAPSE_TRIALS: usize = 40;
 /// Unknowns of bad triangles whose sensitivities pick the integers
 /// [`Quantizer::uncollapse`] tries, at most per round.
 pub(super) const UNCOLLAPSE_PROBES: usize = 48;
@@ -66,7 +66,7 @@ pub(super) const RELAX_ITERATIONS: usize = 8;
 const RELAX_FACTOR: f64 = 0.5;
 
 impl Quantizer {
-    /// The untangler's options in [`Self::polish`]: the default, its total
+    /// The untangler's options in [`Self::polish_stiffened`]: the default, its total
     /// iterations and patience scaled by [`Self::budget`] (patience at
     /// least [`MIN_UNTANGLE_PATIENCE`]).
     pub(super) fn polish_untangle(&self) -> UntangleOptions {
@@ -76,21 +76,6 @@ impl Quantizer {
             patience: self.budget(default.patience).max(MIN_UNTANGLE_PATIENCE),
             ..default
         }
-    }
-
-    /// [`Self::stiffened`] and [`Self::polish_stiffened`]: the whole polish
-    /// of the rounded map `x`.
-    pub(super) fn polish(
-        &self,
-        x: Vec<f64>,
-        system: &RoundedSystem,
-        targets: &[[[f64; 2]; 2]],
-        s: f64,
-        stiffen: bool,
-        bound: Option<usize>,
-    ) -> Result<Polished, QuantizeError> {
-        let start = self.stiffened(x, system, targets, s, stiffen)?;
-        self.polish_stiffened(start, system, targets, s, stiffen, bound)
     }
 
     /// The rounded map `x` as its polish starts: where it is bad and with
@@ -258,8 +243,9 @@ impl Quantizer {
     }
 
     /// The rounded map `rounded` (integers `values`) with integers moved off
-    /// its collapses ([`Self::uncollapse`]) and polished ([`Self::polish`]
-    /// with `stiffen` and `bound`); `None` where no move was kept.
+    /// its collapses ([`Self::uncollapse`]) and polished ([`Self::stiffened`],
+    /// [`Self::polish_stiffened`] with `stiffen` and `bound`); `None` where
+    /// no move was kept.
     /// `system`'s rows are as given on return.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn polish_moved(
@@ -277,7 +263,11 @@ impl Quantizer {
         let (rows, solution) = (system.b.clone(), system.x.clone());
         let (mut values, mut x) = (values.to_vec(), rounded.to_vec());
         let moves = self.uncollapse(&mut values, &mut x, system, x0, targets, s, separations)?;
-        let moved = if moves > 0 { Some(Moved { polish: self.polish(x, system, targets, s, stiffen, bound)?, values, moves }) } else { None };
+        let mut moved = None;
+        if moves > 0 {
+            let start = self.stiffened(x, system, targets, s, stiffen)?;
+            moved = Some(Moved { polish: self.polish_stiffened(start, system, targets, s, stiffen, bound)?, values, moves });
+        }
         (system.b, system.x) = (rows, solution);
         Ok(moved)
     }
@@ -474,7 +464,8 @@ pub(super) struct Moved {
     pub(super) moves: usize,
 }
 
-/// What [`Quantizer::polish`] made of a rounded map: the map, its
+/// What the polish ([`Quantizer::stiffened`], [`Quantizer::polish_stiffened`])
+/// made of a rounded map: the map, its
 /// [`Quantizer::badness`] and that of the map it was given, the ARAP
 /// iterations kept, whether the untangler left no fold, and the local
 /// stiffening iterations it started from.

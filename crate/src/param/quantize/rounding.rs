@@ -39,14 +39,15 @@ pub(super) const MIN_BUDGET_SHARE: f64 = 0.1;
 impl Quantizer {
     /// One greedy rounding of all forms with the fit `fit` (batches of
     /// [`BATCH_FRACTION`], each re-solved, separations restored), then
-    /// [`Self::polish`], and where the map is still bad [`Self::uncollapse`]
-    /// and polish again, keeping the better. With `pass.hold`, the relaxed
+    /// its polish ([`Self::stiffened`], [`Self::polish_stiffened`]) and,
+    /// where the map is bad, the polish of the map with integers moved off
+    /// its collapses ([`Self::polish_moved`]), keeping the better. With `pass.hold`, the relaxed
     /// map first and every batch after it hold the separations they leave
     /// violated ([`HeldApart`]); with `pass.widen` too, held rows are
     /// widened first ([`Self::widen_held`]), and the pass is not run
     /// (`None`) where that widens nothing: it would repeat the held pass.
     /// `bound`: the badness of the best map of the earlier passes where it
-    /// is bad; a map far worse is not untangled ([`Self::polish`]).
+    /// is bad; a map far worse is not untangled ([`Self::polish_stiffened`]).
     pub(super) fn round_and_polish(&self, fit: &Fit, grid: &GridStart, pass: Pass, bound: Option<usize>, progress: &mut dyn FnMut(usize, usize)) -> Result<Option<Rounded>, QuantizeError> {
         let GridStart { x0, targets, s, rules } = grid;
         let s = *s;
