@@ -41,10 +41,10 @@ impl Quantizer {
     /// [`BATCH_FRACTION`], each re-solved, separations restored), then
     /// its polish ([`Self::stiffened`], [`Self::polish_stiffened`]) and,
     /// where the map is bad, the polish of the map with integers moved off
-    /// its collapses ([`Self::polish_moved`]), keeping the better. With `pass.hold`, the relaxed
-    /// map first and every batch after it hold the separations they leave
-    /// violated ([`HeldApart`]); with `pass.widen` too, held rows are
-    /// widened first ([`Self::widen_held`]), and the pass is not run
+    /// its collapses ([`Self::polish_moved`]), keeping the better. With
+    /// `pass.hold`, the relaxed map first and every batch after it hold the
+    /// separations they leave violated ([`HeldApart`]); with `pass.widen`
+    /// too, held rows are widened first ([`Self::widen_held`]), and the pass is not run
     /// (`None`) where that widens nothing: it would repeat the held pass.
     /// `bound`: the badness of the best map of the earlier passes where it
     /// is bad; a map far worse is not untangled ([`Self::polish_stiffened`]).
