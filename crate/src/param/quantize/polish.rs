@@ -24,7 +24,8 @@ pub(super) const WOUND_WEIGHT: usize = 16;
 /// rounding so far, or than the same rounding with its integers moved off
 /// the collapses ([`Quantizer::uncollapse`], polished first), a map may be
 /// after its local stiffening for [`Quantizer::polish_stiffened`] to
-/// untangle it; worse ones hold their folds with their integers. Fandisk >60° at 700 quads: the held and widened passes'
+/// untangle it; worse ones hold their folds with their integers. Fandisk
+/// >60° at 700 quads: the held and widened passes'
 /// 1 900 bad faces against the plain pass's 51 ended at 1 800-1 900, after
 /// 3-5 s of untangling each; cow at 700: the held, widened and graded
 /// passes' 980-1 900 against 32 ended at 64-650. The most a kept map was
@@ -66,9 +67,9 @@ pub(super) const RELAX_ITERATIONS: usize = 8;
 const RELAX_FACTOR: f64 = 0.5;
 
 impl Quantizer {
-    /// The untangler's options in [`Self::polish_stiffened`]: the default, its total
-    /// iterations and patience scaled by [`Self::budget`] (patience at
-    /// least [`MIN_UNTANGLE_PATIENCE`]).
+    /// The untangler's options in [`Self::polish_stiffened`]: the default,
+    /// its total iterations and patience scaled by [`Self::budget`]
+    /// (patience at least [`MIN_UNTANGLE_PATIENCE`]).
     pub(super) fn polish_untangle(&self) -> UntangleOptions {
         let default = UntangleOptions::default();
         UntangleOptions {
@@ -245,8 +246,7 @@ impl Quantizer {
     /// The rounded map `rounded` (integers `values`) with integers moved off
     /// its collapses ([`Self::uncollapse`]) and polished ([`Self::stiffened`],
     /// [`Self::polish_stiffened`] with `stiffen` and `bound`); `None` where
-    /// no move was kept.
-    /// `system`'s rows are as given on return.
+    /// no move was kept. `system`'s rows are as given on return.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn polish_moved(
         &self,
