@@ -897,3 +897,39 @@ fn pillows_glued_to_the_mesh_are_removed() {
     assert_eq!(q.defects.len(), 1);
     assert_eq!(q.defects[0].face, 7);
 }
+
+/// The cube's quads with the band around its middle taken out except two
+/// quads that touch at one corner: the two pieces meet at that vertex
+/// only, each with one hole through it. Filling both holes would leave two
+/// spheres joined at a point; the vertex is opened and the holes joined
+/// instead, into one closed manifold sphere.
+#[test]
+fn pieces_that_meet_at_a_vertex_are_joined() {
+    let (pos, tris, uv) = cube(4, 1.0, false, 0.0);
+    let m = mesh(pos, tris);
+    let mut q = extract(&m, &uv);
+    assert!(q.defects.is_empty(), "{:?}", q.defects);
+    let z = |v: u32| q.positions[v as usize][2];
+    let p = |v: u32| q.positions[v as usize];
+    // The pinch: a vertex at mid-height inside the face y = 0.
+    let pinch = (0..q.n_vertices() as u32).find(|&v| z(v) == 0.5 && p(v)[1] == 0.0 && p(v)[0] == 0.5).expect("a vertex at (0.5, 0, 0.5)");
+    let band = |quad: &[u32; 4]| quad.iter().any(|&v| (0.3..0.7).contains(&z(v)));
+    let at_pinch = |quad: &[u32; 4]| quad.contains(&pinch);
+    // Of the four band quads at the pinch keep the one below and left and the one above and right.
+    let keep = |quad: &[u32; 4]| {
+        let c = quad.iter().fold([0.0; 3], |c, &v| [c[0] + p(v)[0] / 4.0, c[1] + p(v)[1] / 4.0, c[2] + p(v)[2] / 4.0]);
+        at_pinch(quad) && ((c[0] < 0.5 && c[2] < 0.5) || (c[0] > 0.5 && c[2] > 0.5))
+    };
+    let kept: Vec<[u32; 4]> = q.quads.iter().filter(|quad| !band(quad) || keep(quad)).copied().collect();
+    assert_eq!(kept.len(), q.n_quads() - 32 + 2);
+    q.quads = kept;
+    q.uv = (0..q.quads.len()).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]).collect();
+    assert_eq!(topology(&q).euler, 1, "two disks' worth of quads joined at one vertex");
+    super::fill::fill_holes(&m, &mut q);
+    assert!(q.defects.iter().any(|d| d.what.contains("joined with")), "{:?}", q.defects);
+    let t = topology(&q);
+    assert!(t.manifold, "{t:?}");
+    assert_eq!((t.euler, t.boundary_loops), (2, 0), "{t:?}");
+    assert!(q.quads.iter().all(|quad| !quad.contains(&pinch)), "the pinch is opened");
+    assert_on_surface(&m, &q);
+}

@@ -235,8 +235,9 @@ const REPAIR_ROUNDS: usize = 4;
 /// of cells the map winds around that overlap, or a trace that does not
 /// come back): removes every quad with a side another quad also has in
 /// the same direction (so every edge of three or more quads loses two),
-/// or through a vertex a hole's loop passes twice, until the loops are
-/// simple, so the holes left can be filled. The number of quads removed
+/// or through a vertex a hole's loop passes twice or two holes pass, until
+/// the loops are simple and apart, so the holes left can be filled (or
+/// joined, where the pieces they separate met at a vertex). The number of quads removed
 /// and the input face under the first.
 fn open_non_manifold(mesh: &TriMesh, quads: &mut QuadMesh) -> (usize, u32) {
     let (mut removed, mut face) = (0, 0);
@@ -249,8 +250,17 @@ fn open_non_manifold(mesh: &TriMesh, quads: &mut QuadMesh) -> (usize, u32) {
             }
         }
         let bad_side = |a: u32, b: u32| a == b || directed[&(a, b)] > 1;
+        // A vertex two holes pass through (two fans of quads meeting at a
+        // point) is opened too, so the pieces it joins can be bridged.
+        let mut hole_sides_from = vec![0usize; quads.n_vertices()];
+        for &(a, b) in directed.keys() {
+            if !directed.contains_key(&(b, a)) {
+                hole_sides_from[b as usize] += 1;
+            }
+        }
+        let pinches = (0..quads.n_vertices() as u32).filter(|&v| hole_sides_from[v as usize] > 1);
         let mut bad_vertex = vec![false; quads.n_vertices()];
-        for v in holes(quads).1 {
+        for v in holes(quads).1.into_iter().chain(pinches) {
             // The input's own boundary may touch itself; only holes are opened.
             if !on_input_boundary(mesh, quads.locations[v as usize]) {
                 bad_vertex[v as usize] = true;
