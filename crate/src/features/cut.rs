@@ -3,7 +3,7 @@
 
 use super::FeatureSet;
 use crate::mesh::{TriMesh, UnionFind, NONE};
-use crate::vec3::{dot, sub};
+use crate::vec3::{dot, sub, V3};
 use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -157,7 +157,7 @@ pub fn boundary_turning(mesh: &TriMesh) -> Vec<i32> {
         let mut need = (target - sum[c]).unsigned_abs() as usize;
         need -= spread_along_loops(mesh, &loops[c], step, need, &turning, &mut k);
         while need > 0 {
-            let order = closest_order(&corners[c], step, &turning, &k);
+            let order = closest_order(mesh, &corners[c], step, &turning, &k);
             if order.is_empty() {
                 break;
             }
@@ -199,7 +199,9 @@ fn spread_along_loops(mesh: &TriMesh, loops: &[Vec<u32>], step: i32, need: usize
     let exact: Vec<f64> = lost.iter().map(|d| need as f64 * d / all).collect();
     let mut share: Vec<usize> = exact.iter().map(|e| e.floor() as usize).collect();
     let mut by_remainder: Vec<usize> = (0..loops.len()).collect();
-    by_remainder.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())).then(a.cmp(&b)));
+    // Equal remainders (alike loops) by a key of their positions, not their numbering.
+    let key: Vec<u64> = own.iter().map(|l| l.iter().map(|&v| spread(mesh.position(v))).min().unwrap_or(0)).collect();
+    by_remainder.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())).then(key[a].cmp(&key[b])));
     let left = need.saturating_sub(share.iter().sum::<usize>()); // < loops.len(): the remainders add to less
     for &l in by_remainder.iter().take(left) {
         share[l] += 1;
@@ -207,7 +209,7 @@ fn spread_along_loops(mesh: &TriMesh, loops: &[Vec<u32>], step: i32, need: usize
     let mut moved = 0;
     for (l, vertices) in own.iter().enumerate() {
         let n = share[l].min(lost[l].round() as usize);
-        let mut order = closest_order(vertices, step, turning, k);
+        let mut order = closest_order(mesh, vertices, step, turning, k);
         order.retain(|c| c.0 > 0.0);
         for v in spread_ties(mesh, &order, n.min(order.len())) {
             k[v as usize] += step;
@@ -237,11 +239,11 @@ fn closeness(v: u32, step: i32, turning: &[f64], k: &[i32]) -> f64 {
 
 /// The `corners` that may move by `step` (none above 1), as `(closeness,
 /// tie hash, vertex)` sorted by [`closest_first`].
-fn closest_order(corners: &[u32], step: i32, turning: &[f64], k: &[i32]) -> Vec<(f64, u64, u32)> {
+fn closest_order(mesh: &TriMesh, corners: &[u32], step: i32, turning: &[f64], k: &[i32]) -> Vec<(f64, u64, u32)> {
     let mut order: Vec<(f64, u64, u32)> = corners
         .iter()
         .filter(|&&v| step < 0 || k[v as usize] < 1)
-        .map(|&v| (closeness(v, step, turning, k), spread(v), v))
+        .map(|&v| (closeness(v, step, turning, k), spread(mesh.position(v)), v))
         .collect();
     order.sort_by(closest_first);
     order
@@ -300,9 +302,12 @@ fn closest_first(a: &(f64, u64, u32), b: &(f64, u64, u32)) -> std::cmp::Ordering
 /// [`boundary_turning`] rounds the corners as a whole.
 pub const MAX_ROUNDING_DRIFT: i64 = 2;
 
-/// A fixed scramble of a vertex id (splitmix64), to break exact ties evenly.
-fn spread(v: u32) -> u64 {
-    let mut z = (v as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+/// A fixed scramble of a vertex position (splitmix64 of its coordinates'
+/// bits), to break exact ties evenly and the same way however the mesh is
+/// numbered or whatever else its file holds.
+fn spread(p: V3) -> u64 {
+    let bits = p.iter().fold(0u64, |h, x| h.rotate_left(21) ^ x.to_bits());
+    let mut z = bits.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
@@ -335,6 +340,29 @@ mod tests {
         }
         let outer: i32 = (0..mesh.n_vertices()).filter(|&v| !hole.contains(&(v as u32))).map(|v| k[v]).sum();
         assert_eq!(outer, 4, "the square keeps its four convex corners");
+    }
+
+    /// The corners a round hole's drift puts on its rim are chosen by
+    /// position, not numbering: the same mesh with its faces in reverse
+    /// order (so every vertex renumbered) gets corners at the same points.
+    /// (By vertex id the ties fell elsewhere, and a part's cones changed
+    /// with what came before it in its file.)
+    #[test]
+    fn corners_do_not_depend_on_the_numbering() {
+        use crate::mesh::{RawMesh, TriMesh};
+        let mesh = square_with_round_hole(12, 4, 0.4);
+        let reversed = RawMesh { positions: mesh.positions().to_vec(), triangles: mesh.faces().iter().rev().copied().collect() };
+        let renumbered = TriMesh::from_raw(&reversed).unwrap();
+        assert_ne!(renumbered.positions(), mesh.positions(), "the vertices are renumbered");
+        let corners = |m: &TriMesh| {
+            let k = boundary_turning(m);
+            let mut at: Vec<([u64; 3], i32)> = (0..m.n_vertices()).filter(|&v| k[v] != 0).map(|v| (m.position(v as u32).map(f64::to_bits), k[v])).collect();
+            at.sort_unstable();
+            at
+        };
+        let before = corners(&mesh);
+        assert_eq!(before.len(), 8, "four corners on the square, four on the hole");
+        assert_eq!(corners(&renumbered), before);
     }
 
     /// A double cone with three quarters of its rim marked and a meridian
