@@ -85,9 +85,9 @@ test('quads returns exactly the fields of QuadsResult: a valid quad mesh, grid U
 });
 
 test('quads of a low-poly mesh are traced on a map solved again on its refinement, once', () => {
-  // 20 segments: the UV map keeps the input triangles (from 24 segments up
-  // it splits long edges: its caps' corners, spread 90° apart, fold the
-  // fans of thin triangles; bunched, they gave maps of distortion 0.44-0.66).
+  // 20 segments: the UV map keeps the input triangles (its caps' corners,
+  // spread 90° apart at the same angles on both caps, fold none of the fans
+  // of thin triangles; bunched, they gave maps of distortion 0.44-0.66).
   const n = 20;
   const session = wasm.MeshSession.open([{ name: 'cylinder.obj', bytes: new TextEncoder().encode(cadCylinderObj(n)) }]);
   const faces = session.indices().length / 3;

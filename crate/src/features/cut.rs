@@ -200,8 +200,8 @@ fn spread_along_loops(mesh: &TriMesh, loops: &[Vec<u32>], step: i32, need: usize
     let mut share: Vec<usize> = exact.iter().map(|e| e.floor() as usize).collect();
     let mut by_remainder: Vec<usize> = (0..loops.len()).collect();
     // Equal remainders (alike loops) by a key of their positions, not their numbering.
-    let key: Vec<u64> = own.iter().map(|l| l.iter().map(|&v| spread(mesh.position(v))).min().unwrap_or(0)).collect();
-    by_remainder.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())).then(key[a].cmp(&key[b])));
+    let key: Vec<V3> = own.iter().map(|l| l.iter().map(|&v| mesh.position(v)).min_by(lexicographic).unwrap_or_default()).collect();
+    by_remainder.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())).then(lexicographic(&key[a], &key[b])));
     let left = need.saturating_sub(share.iter().sum::<usize>()); // < loops.len(): the remainders add to less
     for &l in by_remainder.iter().take(left) {
         share[l] += 1;
@@ -237,13 +237,13 @@ fn closeness(v: u32, step: i32, turning: &[f64], k: &[i32]) -> f64 {
     step as f64 * (turning[v as usize] - k[v as usize] as f64)
 }
 
-/// The `corners` that may move by `step` (none above 1), as `(closeness,
-/// tie hash, vertex)` sorted by [`closest_first`].
-fn closest_order(mesh: &TriMesh, corners: &[u32], step: i32, turning: &[f64], k: &[i32]) -> Vec<(f64, u64, u32)> {
-    let mut order: Vec<(f64, u64, u32)> = corners
+/// The `corners` that may move by `step` (none above 1), sorted by
+/// [`closest_first`].
+fn closest_order(mesh: &TriMesh, corners: &[u32], step: i32, turning: &[f64], k: &[i32]) -> Vec<Corner> {
+    let mut order: Vec<Corner> = corners
         .iter()
         .filter(|&&v| step < 0 || k[v as usize] < 1)
-        .map(|&v| (closeness(v, step, turning, k), spread(mesh.position(v)), v))
+        .map(|&v| (closeness(v, step, turning, k), mesh.position(v), v))
         .collect();
     order.sort_by(closest_first);
     order
@@ -260,7 +260,7 @@ const SAME_TURNING: f64 = 1e-3;
 /// whose vertices all turn alike, gets its corners evenly spaced, as a
 /// square hole's; by closeness alone they follow the rounding noise of the
 /// export (a CAD bracket's holes: three corners within 15°, twice).
-fn spread_ties(mesh: &TriMesh, order: &[(f64, u64, u32)], count: usize) -> Vec<u32> {
+fn spread_ties(mesh: &TriMesh, order: &[Corner], count: usize) -> Vec<u32> {
     let mut picked = Vec::with_capacity(count);
     let mut taken = vec![false; order.len()];
     // Squared distance of each corner to the nearest picked one.
@@ -288,30 +288,32 @@ fn spread_ties(mesh: &TriMesh, order: &[(f64, u64, u32)], count: usize) -> Vec<u
     picked
 }
 
-/// Order of corners `(closeness, tie hash, vertex)` for [`boundary_turning`]:
-/// closest to going the other way first, closeness in buckets of 1e-9 and
-/// ties by hash. (A tolerance comparison is not a total order, and the sort
-/// panicked on it: a jittered bff-face x4.)
-fn closest_first(a: &(f64, u64, u32), b: &(f64, u64, u32)) -> std::cmp::Ordering {
+/// A boundary corner for [`boundary_turning`]: `(closeness, position, vertex)`.
+type Corner = (f64, V3, u32);
+
+/// Order of corners for [`boundary_turning`]: closest to going the other
+/// way first, closeness in buckets of 1e-9, ties by position
+/// ([`lexicographic`]). (A tolerance comparison is not a total order, and
+/// the sort panicked on it: a jittered bff-face x4.)
+fn closest_first(a: &Corner, b: &Corner) -> std::cmp::Ordering {
     let bucket = |x: f64| (x * 1e9).round();
-    bucket(b.0).total_cmp(&bucket(a.0)).then(a.1.cmp(&b.1))
+    bucket(b.0).total_cmp(&bucket(a.0)).then(lexicographic(&a.1, &b.1))
+}
+
+/// Positions by x, then y, then z: how exact ties between corners are
+/// broken. It does not depend on the numbering (a part's corners are the
+/// same whatever else its file holds, and in whatever order), and alike
+/// loops in parallel planes start at matching points (the two caps of a
+/// cylinder get their corners at the same angles, so its side maps without
+/// a twist).
+fn lexicographic(a: &V3, b: &V3) -> std::cmp::Ordering {
+    a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])).then(a[2].total_cmp(&b[2]))
 }
 
 /// Difference (quarter turns) between what a component's interior must
 /// carry after independent corner rounding and its own curvature from which
 /// [`boundary_turning`] rounds the corners as a whole.
 pub const MAX_ROUNDING_DRIFT: i64 = 2;
-
-/// A fixed scramble of a vertex position (splitmix64 of its coordinates'
-/// bits), to break exact ties evenly and the same way however the mesh is
-/// numbered or whatever else its file holds.
-fn spread(p: V3) -> u64 {
-    let bits = p.iter().fold(0u64, |h, x| h.rotate_left(21) ^ x.to_bits());
-    let mut z = bits.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
 
 #[cfg(test)]
 mod tests {
@@ -423,7 +425,7 @@ mod tests {
     /// transitive, antisymmetric, and a sort of them does not panic.
     #[test]
     fn corner_order_is_a_total_order() {
-        let values: Vec<(f64, u64, u32)> = (0..200u32).map(|i| (0.3 + i as f64 * 0.6e-9, (i as u64 * 7919) % 97, i)).collect();
+        let values: Vec<super::Corner> = (0..200u32).map(|i| (0.3 + i as f64 * 0.6e-9, [((i * 7919) % 97) as f64, 0.0, 0.0], i)).collect();
         for a in &values {
             for b in &values {
                 assert_eq!(closest_first(a, b), closest_first(b, a).reverse());
