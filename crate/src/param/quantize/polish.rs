@@ -24,8 +24,8 @@ pub(super) const WOUND_WEIGHT: usize = 16;
 /// rounding so far, or than the same rounding with its integers moved off
 /// the collapses ([`Quantizer::uncollapse`], polished first), a map may be
 /// after its local stiffening for [`Quantizer::polish_stiffened`] to
-/// untangle it; worse ones hold their folds with their integers. Fandisk
-/// >60° at 700 quads: the held and widened passes'
+/// untangle it; worse ones hold their folds with their integers. On the
+/// fandisk with creases over 60° at 700 quads: the held and widened passes'
 /// 1 900 bad faces against the plain pass's 51 ended at 1 800-1 900, after
 /// 3-5 s of untangling each; cow at 700: the held, widened and graded
 /// passes' 980-1 900 against 32 ended at 64-650. The most a kept map was
