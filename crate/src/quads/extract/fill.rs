@@ -8,8 +8,8 @@
 //! one with an even number of sides is filled with quads whose new vertices
 //! lie on the input surface, and recorded as a defect; one that reaches the
 //! input's boundary is closed with new vertices along it. Two holes that
-//! cut the quads into more pieces than the input has are joined by a strip
-//! of quads instead (`bridge`). Odd and overlong holes stay open (also
+//! cut the quads on one component of the input into two pieces are joined
+//! by a strip of quads instead (`bridge`). Odd and overlong holes stay open (also
 //! recorded); a loop through a vertex twice is left as it is.
 
 mod boundary;

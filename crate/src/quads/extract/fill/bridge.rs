@@ -1,8 +1,9 @@
 //! Holes in pairs. Where the quads removed or skipped form a ring (around a
 //! horn, say), the traced quads fall into two pieces, each with one hole:
-//! filling both with disks would make two closed surfaces of one. While the
-//! quads have more pieces than the input, the nearest two holes of
-//! different pieces are joined by a strip of quads instead.
+//! filling both with disks would make two closed surfaces of one. While a
+//! component of the input has more than one piece of quads on it, the
+//! nearest two holes of different pieces on that component are joined by a
+//! strip of quads instead (never two components: a lid beside its pot).
 
 use crate::mesh::UnionFind;
 use crate::quads::QuadMesh;
@@ -13,12 +14,16 @@ use crate::TriMesh;
 /// the mean of their perimeters apart.
 const MAX_GAP: f64 = 0.5;
 
-/// Pairs of `holes` (indices) to join so that `quads` has no more pieces
-/// than `mesh` has components: nearest centres first, holes of different
-/// pieces with an even number of sides in all.
+/// Pairs of `holes` (indices) to join so that each component of `mesh` has
+/// one piece of `quads` on it: nearest centres first, holes of different
+/// pieces on the same component with an even number of sides in all.
 pub(super) fn pairs_to_join(mesh: &TriMesh, quads: &QuadMesh, holes: &[Vec<u32>]) -> Vec<(usize, usize)> {
     let mut piece = pieces(quads);
-    let mut excess = piece.count_sets(quads.quads.iter().map(|q| q[0])).saturating_sub(mesh.n_components());
+    let component = |v: u32| mesh.face_components()[quads.locations[v as usize].face as usize];
+    let mut on_component: Vec<(u32, u32)> = quads.quads.iter().map(|q| (component(q[0]), piece.find(q[0]))).collect();
+    on_component.sort_unstable();
+    on_component.dedup();
+    let mut excess = on_component.len().saturating_sub(on_component.iter().map(|c| c.0).collect::<std::collections::BTreeSet<_>>().len());
     let centre = |h: &[u32]| -> V3 {
         let mut c = [0.0; 3];
         for &v in h {
@@ -36,7 +41,7 @@ pub(super) fn pairs_to_join(mesh: &TriMesh, quads: &QuadMesh, holes: &[Vec<u32>]
     for i in 0..holes.len() {
         for j in i + 1..holes.len() {
             let (a, b) = (&holes[i], &holes[j]);
-            if (a.len() + b.len()) % 2 == 1 {
+            if (a.len() + b.len()) % 2 == 1 || component(a[0]) != component(b[0]) {
                 continue;
             }
             let gap = norm(sub(centre(a), centre(b)));
@@ -111,4 +116,38 @@ fn pieces(quads: &QuadMesh) -> UnionFind {
         }
     }
     p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pairs_to_join;
+    use crate::mesh::{RawMesh, TriMesh};
+    use crate::quads::{QuadMesh, SurfacePoint};
+
+    /// Three one-quad pieces, each a hole of four sides: one on the first
+    /// component of the input, two on the second. The one on the first is
+    /// nearest to one of the others, but only the two on the second
+    /// component are joined (the pieces are one surface there; across
+    /// components they are not).
+    #[test]
+    fn holes_are_joined_only_on_one_component() {
+        let raw = RawMesh {
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 0.0]],
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+        };
+        let mesh = TriMesh::from_raw(&raw).unwrap();
+        assert_eq!(mesh.n_components(), 2);
+        let square = |x: f64| [[x, 0.0, 0.0], [x + 0.2, 0.0, 0.0], [x + 0.2, 0.2, 0.0], [x, 0.2, 0.0]];
+        let on = |face: u32| SurfacePoint { face, bary: [1.0, 0.0, 0.0] };
+        let (first, second) = (mesh.face_components()[0], mesh.face_components()[1]);
+        assert_ne!(first, second);
+        // Piece 0 on the first component at x = 0.05; pieces 1 and 2 on the
+        // second at x = 0.3 and 0.6: centres 0.25 and 0.3 apart.
+        let positions: Vec<[f64; 3]> = [0.05, 0.3, 0.6].iter().flat_map(|&x| square(x)).collect();
+        let locations: Vec<SurfacePoint> = [0, 1, 1].iter().flat_map(|&f| [on(f); 4]).collect();
+        let quads = vec![[0, 1, 2, 3], [4, 5, 6, 7], [8, 9, 10, 11]];
+        let q = QuadMesh { positions, locations, uv: vec![[0.0; 2]; 12], quads, defects: Vec::new() };
+        let holes: Vec<Vec<u32>> = q.quads.iter().map(|c| c.iter().rev().copied().collect()).collect();
+        assert_eq!(pairs_to_join(&mesh, &q, &holes), vec![(1, 2)]);
+    }
 }
