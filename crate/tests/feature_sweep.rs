@@ -283,6 +283,39 @@ fn a_low_poly_cad_cylinder_solves_on_its_own_triangles() {
     assert_eq!(a.aligned, a.requested);
 }
 
+/// A cylinder of 20 segments whose caps are fans from one rim vertex each
+/// (as the page tests' OBJ): its map on the input triangles folds, so it is
+/// solved again from the input with its long edges split
+/// ([`pipeline::long_edges_refine`]), and the result says what was
+/// inserted and to what length. Its distortion is lower than with every
+/// face bisected instead (the fallback after it, reached when a maximum
+/// length was asked).
+#[test]
+fn a_low_poly_map_that_folds_is_solved_again_with_its_long_edges_split() {
+    use std::f64::consts::PI;
+    let n = 20u32;
+    let positions = [0.0, 2.0]
+        .iter()
+        .flat_map(|&z| (0..n).map(move |i| [(2.0 * PI * i as f64 / n as f64).cos(), (2.0 * PI * i as f64 / n as f64).sin(), z]))
+        .collect();
+    let mut triangles: Vec<[u32; 3]> = (0..n).flat_map(|i| [[i, (i + 1) % n, n + (i + 1) % n], [i, n + (i + 1) % n, n + i]]).collect();
+    triangles.extend((1..n - 1).flat_map(|i| [[0, i + 1, i], [n, n + i, n + i + 1]]));
+    let mesh = TriMesh::from_raw(&conemap::mesh::RawMesh { positions, triangles }).unwrap();
+    let features = FeatureSet::sharp_edges(&mesh, 60.0);
+    assert_eq!(features.len(), 2 * n as usize);
+    let solution = check("fan-capped cylinder", &mesh, &features);
+    let length = conemap::pipeline::QUAD_MAX_EDGE * mesh.bounding_diagonal();
+    assert_eq!(solution.refine_options.max_edge_length, Some(length));
+    assert!(solution.refinement.long_edges > 0, "{:?}", solution.refinement);
+    assert!((0..solution.mesh.n_edges() as u32).all(|e| solution.mesh.edge_length(e) <= length));
+    let asked = RefineOptions { max_edge_length: Some(10.0 * mesh.bounding_diagonal()), ..RefineOptions::default() };
+    let everywhere = solve(&mesh, &features, &SolveOptions { refine: asked, ..SolveOptions::default() }, &mut |_| {}).unwrap();
+    assert_eq!(everywhere.refinement.long_edges, 0);
+    assert_eq!(everywhere.param.metrics.flipped, 0);
+    let (split, bisected) = (solution.param.metrics.distortion, everywhere.param.metrics.distortion);
+    assert!(split < bisected, "distortion {split} with long edges split, {bisected} bisected everywhere");
+}
+
 /// With features, the cone moves' proxy can disagree with the map: on spot
 /// at --sharp 40 the moves merged 75 cones into 36 and doubled the map's
 /// distortion (0.14 -> 0.25). The placement without moves is parametrized
