@@ -9,8 +9,8 @@
 //! lie on the input surface, and recorded as a defect; one that reaches the
 //! input's boundary is closed with new vertices along it. Two holes that
 //! cut the quads on one component of the input into two pieces are joined
-//! by a strip of quads instead (`bridge`). Odd and overlong holes stay open (also
-//! recorded); a loop through a vertex twice is left as it is.
+//! by a strip of quads instead (`bridge`). Odd and overlong holes stay
+//! open (also recorded); a loop through a vertex twice is left as it is.
 
 mod boundary;
 mod bridge;
@@ -237,8 +237,8 @@ const REPAIR_ROUNDS: usize = 4;
 /// the same direction (so every edge of three or more quads loses two),
 /// or through a vertex a hole's loop passes twice or two holes pass, until
 /// the loops are simple and apart, so the holes left can be filled (or
-/// joined, where the pieces they separate met at a vertex). The number of quads removed
-/// and the input face under the first.
+/// joined, where the pieces they separate met at a vertex). The number of
+/// quads removed and the input face under the first.
 fn open_non_manifold(mesh: &TriMesh, quads: &mut QuadMesh) -> (usize, u32) {
     let (mut removed, mut face) = (0, 0);
     for _ in 0..REPAIR_ROUNDS {

@@ -20,10 +20,13 @@ const MAX_GAP: f64 = 0.5;
 pub(super) fn pairs_to_join(mesh: &TriMesh, quads: &QuadMesh, holes: &[Vec<u32>]) -> Vec<(usize, usize)> {
     let mut piece = pieces(quads);
     let component = |v: u32| mesh.face_components()[quads.locations[v as usize].face as usize];
+    // (input component, piece) of every quad: each piece past a
+    // component's first needs a join.
     let mut on_component: Vec<(u32, u32)> = quads.quads.iter().map(|q| (component(q[0]), piece.find(q[0]))).collect();
     on_component.sort_unstable();
     on_component.dedup();
-    let mut excess = on_component.len().saturating_sub(on_component.iter().map(|c| c.0).collect::<std::collections::BTreeSet<_>>().len());
+    let components: std::collections::BTreeSet<u32> = on_component.iter().map(|c| c.0).collect();
+    let mut excess = on_component.len() - components.len();
     let centre = |h: &[u32]| -> V3 {
         let mut c = [0.0; 3];
         for &v in h {
