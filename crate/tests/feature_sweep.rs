@@ -284,7 +284,7 @@ fn a_low_poly_cad_cylinder_solves_on_its_own_triangles() {
 }
 
 /// A cylinder of 20 segments whose caps are fans from one rim vertex each
-/// (as the page tests' OBJ): its map on the input triangles folds, so it is
+/// ([`shapes::fan_capped_cylinder`], as the page tests' OBJ): its map on the input triangles folds, so it is
 /// solved again from the input with its long edges split
 /// ([`pipeline::long_edges_refine`]), and the result says what was
 /// inserted and to what length. Its distortion is lower than with every
@@ -292,17 +292,11 @@ fn a_low_poly_cad_cylinder_solves_on_its_own_triangles() {
 /// length was asked).
 #[test]
 fn a_low_poly_map_that_folds_is_solved_again_with_its_long_edges_split() {
-    use std::f64::consts::PI;
-    let n = 20u32;
-    let positions = [0.0, 2.0]
-        .iter()
-        .flat_map(|&z| (0..n).map(move |i| [(2.0 * PI * i as f64 / n as f64).cos(), (2.0 * PI * i as f64 / n as f64).sin(), z]))
-        .collect();
-    let mut triangles: Vec<[u32; 3]> = (0..n).flat_map(|i| [[i, (i + 1) % n, n + (i + 1) % n], [i, n + (i + 1) % n, n + i]]).collect();
-    triangles.extend((1..n - 1).flat_map(|i| [[0, i + 1, i], [n, n + i, n + i + 1]]));
-    let mesh = TriMesh::from_raw(&conemap::mesh::RawMesh { positions, triangles }).unwrap();
+    let n = 20;
+    let mesh = TriMesh::from_raw(&conemap::mesh::shapes::fan_capped_cylinder(n, 2.0)).unwrap();
+    assert_eq!(mesh.n_faces(), 4 * n - 4);
     let features = FeatureSet::sharp_edges(&mesh, 60.0);
-    assert_eq!(features.len(), 2 * n as usize);
+    assert_eq!(features.len(), 2 * n);
     let solution = check("fan-capped cylinder", &mesh, &features);
     let length = conemap::pipeline::QUAD_MAX_EDGE * mesh.bounding_diagonal();
     assert_eq!(solution.refine_options.max_edge_length, Some(length));

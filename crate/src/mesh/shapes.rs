@@ -35,8 +35,42 @@ pub fn grid(nx: usize, ny: usize, embed: impl Fn(f64, f64) -> [f64; 3]) -> RawMe
 /// strip of long, thin triangles across the disk (no interior vertex). The
 /// rims are the only sharp edges (90°).
 pub fn cad_cylinder(n_around: usize, height: f64) -> RawMesh {
-    use std::f64::consts::PI;
     assert!(n_around >= 4 && n_around.is_multiple_of(2), "cad_cylinder: an even number of segments, at least 4");
+    let n = n_around as u32;
+    // The strip grows from rim vertex n/2 to either side until it closes at 0.
+    let (mut left, mut right) = (n / 2 - 1, n / 2 + 1);
+    let mut strip = vec![[left, n / 2, right]];
+    while strip.len() < n_around - 2 {
+        if strip.len() % 2 == 1 {
+            strip.push([left - 1, left, right]);
+            left -= 1;
+        } else {
+            strip.push([left, right, (right + 1) % n]);
+            right = (right + 1) % n;
+        }
+    }
+    // On a convex polygon a triangle listed in increasing index order is
+    // counter-clockwise.
+    cylinder_with_caps(n_around, height, strip.into_iter().map(|mut t| {
+        t.sort_unstable();
+        t
+    }))
+}
+
+/// [`cad_cylinder`] with each cap a fan of triangles from its first rim
+/// vertex instead of a zigzag strip, as many exporters write a polygon
+/// (the page tests' OBJ, `scripts/lib/cad-cylinder.mjs`); `n_around` at
+/// least 3.
+pub fn fan_capped_cylinder(n_around: usize, height: f64) -> RawMesh {
+    assert!(n_around >= 3, "fan_capped_cylinder: at least 3 segments");
+    cylinder_with_caps(n_around, height, (1..n_around as u32 - 1).map(|i| [0, i, i + 1]))
+}
+
+/// The closed cylinder of [`cad_cylinder`] with caps triangulated by `cap`:
+/// triangles over rim indices `0..n_around`, counter-clockwise seen from +z
+/// (the top cap as given, the bottom one reversed).
+fn cylinder_with_caps(n_around: usize, height: f64, cap: impl Iterator<Item = [u32; 3]>) -> RawMesh {
+    use std::f64::consts::PI;
     let n = n_around as u32;
     let positions = [0.0, height]
         .iter()
@@ -52,22 +86,7 @@ pub fn cad_cylinder(n_around: usize, height: f64) -> RawMesh {
         let (a, b, c, d) = (i, (i + 1) % n, n + (i + 1) % n, n + i);
         triangles.extend([[a, b, c], [a, c, d]]);
     }
-    // The strip grows from rim vertex n/2 to either side until it closes at 0.
-    let (mut left, mut right) = (n / 2 - 1, n / 2 + 1);
-    let mut strip = vec![[left, n / 2, right]];
-    while strip.len() < n_around - 2 {
-        if strip.len() % 2 == 1 {
-            strip.push([left - 1, left, right]);
-            left -= 1;
-        } else {
-            strip.push([left, right, (right + 1) % n]);
-            right = (right + 1) % n;
-        }
-    }
-    // On a convex polygon a triangle listed in increasing index order is
-    // counter-clockwise: seen from +z on the top cap, from -z reversed.
-    for mut t in strip {
-        t.sort_unstable();
+    for t in cap {
         triangles.push([t[2], t[1], t[0]]);
         triangles.push(t.map(|v| v + n));
     }

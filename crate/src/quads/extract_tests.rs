@@ -842,22 +842,27 @@ fn holes_at_the_boundary_are_filled_along_it() {
     assert_positive_areas(&q);
 }
 
+/// A unit cube of 4 x 4 squares per side and its traced quads (no defect).
+fn cube_quads() -> (TriMesh, QuadMesh) {
+    let (pos, tris, uv) = cube(4, 1.0, false, 0.0);
+    let m = mesh(pos, tris);
+    let q = extract(&m, &uv);
+    assert!(q.defects.is_empty(), "{:?}", q.defects);
+    (m, q)
+}
+
 /// The quads of a cube with the band of quads around its middle (no quad
 /// vertex with z in (0.3, 0.7)) taken out fall into two pieces, each with
 /// one hole: filling both would give two closed surfaces; the holes are
 /// joined by a strip of quads instead, into one closed manifold sphere.
 #[test]
 fn holes_that_cut_the_quads_in_two_are_joined() {
-    let (pos, tris, uv) = cube(4, 1.0, false, 0.0);
-    let m = mesh(pos, tris);
-    let mut q = extract(&m, &uv);
-    assert!(q.defects.is_empty(), "{:?}", q.defects);
+    let (m, mut q) = cube_quads();
     let n = q.n_quads();
     let middle = |v: &u32| (0.3..0.7).contains(&q.positions[*v as usize][2]);
-    let band: Vec<usize> = (0..n).filter(|&i| q.quads[i].iter().any(middle)).collect();
-    assert_eq!(band.len(), 4 * 4 * 2, "two rows of quads around");
-    q.quads = q.quads.iter().enumerate().filter(|(i, _)| !band.contains(i)).map(|(_, c)| *c).collect();
-    q.uv = (0..q.quads.len()).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]).collect();
+    let band: Vec<bool> = q.quads.iter().map(|quad| quad.iter().any(middle)).collect();
+    assert_eq!(band.iter().filter(|&&b| b).count(), 4 * 4 * 2, "two rows of quads around");
+    q.remove_quads(&band);
     super::fill::fill_holes(&m, &mut q);
     let joined: Vec<&QuadDefect> = q.defects.iter().filter(|d| d.what.contains("joined with 16 quads")).collect();
     assert_eq!(joined.len(), 1, "{:?}", q.defects);
@@ -905,25 +910,19 @@ fn pillows_glued_to_the_mesh_are_removed() {
 /// instead, into one closed manifold sphere.
 #[test]
 fn pieces_that_meet_at_a_vertex_are_joined() {
-    let (pos, tris, uv) = cube(4, 1.0, false, 0.0);
-    let m = mesh(pos, tris);
-    let mut q = extract(&m, &uv);
-    assert!(q.defects.is_empty(), "{:?}", q.defects);
-    let z = |v: u32| q.positions[v as usize][2];
+    let (m, mut q) = cube_quads();
     let p = |v: u32| q.positions[v as usize];
     // The pinch: a vertex at mid-height inside the face y = 0.
-    let pinch = (0..q.n_vertices() as u32).find(|&v| z(v) == 0.5 && p(v)[1] == 0.0 && p(v)[0] == 0.5).expect("a vertex at (0.5, 0, 0.5)");
-    let band = |quad: &[u32; 4]| quad.iter().any(|&v| (0.3..0.7).contains(&z(v)));
-    let at_pinch = |quad: &[u32; 4]| quad.contains(&pinch);
+    let pinch = (0..q.n_vertices() as u32).find(|&v| p(v) == [0.5, 0.0, 0.5]).expect("a vertex at (0.5, 0, 0.5)");
+    let band = |quad: &[u32; 4]| quad.iter().any(|&v| (0.3..0.7).contains(&p(v)[2]));
     // Of the four band quads at the pinch keep the one below and left and the one above and right.
     let keep = |quad: &[u32; 4]| {
-        let c = quad.iter().fold([0.0; 3], |c, &v| [c[0] + p(v)[0] / 4.0, c[1] + p(v)[1] / 4.0, c[2] + p(v)[2] / 4.0]);
-        at_pinch(quad) && ((c[0] < 0.5 && c[2] < 0.5) || (c[0] > 0.5 && c[2] > 0.5))
+        let c = quad.iter().fold([0.0; 3], |c, &v| crate::vec3::add(c, crate::vec3::scale(p(v), 0.25)));
+        quad.contains(&pinch) && ((c[0] < 0.5 && c[2] < 0.5) || (c[0] > 0.5 && c[2] > 0.5))
     };
-    let kept: Vec<[u32; 4]> = q.quads.iter().filter(|quad| !band(quad) || keep(quad)).copied().collect();
-    assert_eq!(kept.len(), q.n_quads() - 32 + 2);
-    q.quads = kept;
-    q.uv = (0..q.quads.len()).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]).collect();
+    let remove: Vec<bool> = q.quads.iter().map(|quad| band(quad) && !keep(quad)).collect();
+    assert_eq!(remove.iter().filter(|&&r| r).count(), 32 - 2);
+    q.remove_quads(&remove);
     assert_eq!(topology(&q).euler, 1, "two disks' worth of quads joined at one vertex");
     super::fill::fill_holes(&m, &mut q);
     assert!(q.defects.iter().any(|d| d.what.contains("joined with")), "{:?}", q.defects);
