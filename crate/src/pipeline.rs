@@ -20,7 +20,7 @@ use std::fmt;
 mod grid;
 mod location;
 mod parts;
-pub use grid::{grid_map, GridMapped, GridStage, LongEdges};
+pub use grid::{grid_map, GridFeatures, GridMapped, GridStage, LongEdges};
 pub use location::{enclosing_features, ErrorLocation, MAX_LOCATION_EDGES};
 use location::Lift;
 use parts::Parts;

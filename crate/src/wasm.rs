@@ -8,7 +8,7 @@ use crate::export::{self, ExportInput, ExportOptions};
 use crate::param::quantize::{GridSize, QuantizeOptions, QuantizeReport};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
 use crate::quads::{self, check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
-use crate::pipeline::{FeatureAlignment, GridMapped, GridStage, LongEdges, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
+use crate::pipeline::{FeatureAlignment, GridFeatures, GridMapped, GridStage, LongEdges, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
 use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -291,7 +291,7 @@ impl MeshSession {
         let sol = stage.finish(mesh, &features, placed, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
         // (The stage keeps the settings as solved: a low-poly fallback's edge length is not asked again.)
-        self.grid = Some(GridStage::new(sol.into_owned(), features, options, LongEdges::RefineFirst));
+        self.grid = Some(GridStage::new(sol.into_owned(), GridFeatures::asked(mesh, features), options, LongEdges::RefineFirst));
         Ok(result)
     }
 

@@ -113,6 +113,28 @@ fn quads_say_which_features_the_grid_could_not_follow() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `conemap quads` given no features follows a CAD part's creases
+/// (`features::CREASES`: fandisk's 693 edges above 75°): the quads stay
+/// within 1 % of the diagonal and have those edges on quad edges, and the
+/// report and stdout say so; `--sharp none` cuts across them (over 1 %).
+#[test]
+fn quads_follow_a_cad_parts_creases_unless_told_not_to() {
+    let distance = |q: &serde_json::Value| q["distance_input_to_quads_relative"].as_f64().unwrap().max(q["distance_quads_to_input_relative"].as_f64().unwrap());
+    let auto = run_quads("fandisk", "creases", &[]);
+    assert_eq!((&auto.report["detected_feature_edges"], &auto.report["dropped_feature_edges"]), (&693.into(), &0.into()));
+    assert!(auto.stdout.contains("693 of 693 crease edges followed"), "{}", auto.stdout);
+    let q = &auto.report["quads"];
+    assert_eq!(auto.report["defects"].as_array().map(Vec::len), Some(0));
+    assert!(distance(q) < 0.01, "{q}");
+    assert!(q["fraction_sharp_within_tolerance"].as_f64().unwrap() > 0.99, "{q}");
+    let none = run_quads("fandisk", "no-creases", &["--sharp", "none"]);
+    assert_eq!(none.report["detected_feature_edges"], 0);
+    assert!(distance(&none.report["quads"]) > 0.01, "creases cut across: {}", none.report["quads"]);
+    for dir in [auto.dir, none.dir] {
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
 /// `solve --quads` into a `.glb`: read back as the file's f32, every seam
 /// transition is a quarter turn plus an integer translation to the last bit
 /// and every cone an integer point, with coordinates of up to about 64 grid

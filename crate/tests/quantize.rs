@@ -524,7 +524,7 @@ fn a_low_poly_cad_cylinder_is_refined_for_quads() {
 /// grid.
 #[test]
 fn a_low_poly_cad_grid_map_is_solved_again_where_it_folds() {
-    use conemap::pipeline::{grid_map, LongEdges};
+    use conemap::pipeline::{grid_map, GridFeatures, LongEdges};
     let input = common::fixture_mesh("cad/gear.obj");
     let features = FeatureSet::sharp_edges(&input, 60.0);
     let quantize = QuantizeOptions { retry_wound: true, ..QuantizeOptions::default() };
@@ -536,7 +536,7 @@ fn a_low_poly_cad_grid_map_is_solved_again_where_it_folds() {
         let first = solution.quantizer().unwrap().quantize_with(&solution.mesh, GridSize::Quads(quads), &quantize, &mut |_, _| {}).unwrap();
         let input_faults = first.report.flipped + first.report.wound_vertices;
         folded_on_input += usize::from(input_faults > 0);
-        let mapped = grid_map(&input, &features, &options, solution, GridSize::Quads(quads), &quantize, LongEdges::RefineWhereFolded, &mut |_| {}, &mut |_, _| {}).unwrap();
+        let mapped = grid_map(&input, &GridFeatures::asked(&input, features.clone()), &options, solution, GridSize::Quads(quads), &quantize, LongEdges::RefineWhereFolded, &mut |_| {}, &mut |_, _| {}).unwrap();
         let (r, mesh) = (&mapped.map.report, &mapped.solution.mesh);
         assert_eq!((r.flipped, r.wound_vertices), (0, 0), "{name}: {r:?}");
         assert_eq!(mesh.n_faces() > input.n_faces(), input_faults > 0, "{name}: solved again exactly where the input's map folds");
@@ -555,19 +555,17 @@ fn a_low_poly_cad_grid_map_is_solved_again_where_it_folds() {
 #[test]
 fn feature_curves_finer_than_the_grid_are_dropped_where_they_fold_the_map() {
     use conemap::features::finer_than_grid;
-    use conemap::pipeline::{quad_length, GridStage, LongEdges, RefineOptions};
+    use conemap::pipeline::{quad_length, GridFeatures, GridStage, LongEdges, RefineOptions};
     let input = load("teapot.obj");
     let features = FeatureSet::sharp_edges(&input, 60.0);
     let size = GridSize::Quads(3000);
-    let mut options = SolveOptions::default();
-    options.refine = RefineOptions::for_quads(&input, size);
-    let options = options.for_quads(&input, size);
+    let options = SolveOptions { refine: RefineOptions::for_quads(&input, size), ..SolveOptions::default() }.for_quads(&input, size);
     let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
     let first = solution.quantizer().unwrap().quantize(&solution.mesh, size, &mut |_, _| {}).unwrap();
     assert!(first.report.folds() > 0, "the map with the lip no longer folds: this test no longer exercises the fallback");
     let finer = finer_than_grid(&input, &features, quad_length(&input, size));
     assert_eq!((features.len(), finer.len()), (4, 4), "the lip is the one crease, and finer than the grid");
-    let mut stage = GridStage::new(solution, features.clone(), options, LongEdges::RefineFirst);
+    let mut stage = GridStage::new(solution, GridFeatures::asked(&input, features.clone()), options, LongEdges::RefineFirst);
     let mut solves = 0;
     let mapped = stage.map(&input, size, &QuantizeOptions::default(), &mut |_| solves += 1, &mut |_, _| {}).unwrap();
     assert!(solves > 0, "solved again without the lip");
@@ -581,6 +579,32 @@ fn feature_curves_finer_than_the_grid_are_dropped_where_they_fold_the_map() {
     let mut solves = 0;
     let again = stage.map(&input, size, &QuantizeOptions::default(), &mut |_| solves += 1, &mut |_, _| {}).unwrap();
     assert_eq!((solves, &again.dropped_features, &again.map.uv), (0, &finer, &uv));
+}
+
+/// Creases found for a caller that gave no features (`features::CREASES`,
+/// as `quads` finds them) are dropped together wherever they fold the map:
+/// cow's 32 edges above 75° on long curves (ears, horns) fold its map at
+/// 1 000 quads, so it is solved again without any of them, with no fold.
+#[test]
+fn detected_creases_are_dropped_where_they_fold_the_map() {
+    use conemap::features::{detect_sharp, CREASES};
+    use conemap::pipeline::{GridFeatures, GridStage, LongEdges, RefineOptions};
+    let input = load("cow.obj");
+    let creases = detect_sharp(&input, &CREASES).features;
+    assert_eq!(creases.len(), 32);
+    let size = GridSize::Quads(1000);
+    let options = SolveOptions { refine: RefineOptions::for_quads(&input, size), ..SolveOptions::default() }.for_quads(&input, size);
+    let solution = solve(&input, &creases, &options, &mut |_| {}).unwrap();
+    let first = solution.quantizer().unwrap().quantize(&solution.mesh, size, &mut |_, _| {}).unwrap();
+    assert!(first.report.folds() > 0, "the map with the creases no longer folds: this test no longer exercises the fallback");
+    let features = GridFeatures { all: creases.clone(), detected: creases.clone() };
+    let mut stage = GridStage::new(solution, features, options, LongEdges::RefineFirst);
+    let mapped = stage.map(&input, size, &QuantizeOptions::default(), &mut |_| {}, &mut |_, _| {}).unwrap();
+    assert_eq!(mapped.dropped_features, creases, "every detected crease goes");
+    let (r, sol) = (&mapped.map.report, mapped.solution);
+    assert_eq!((r.flipped, r.wound_vertices), (0, 0), "{r:?}");
+    assert!(sol.features.is_empty());
+    assert_eq!(check_integer_grid("cow without its creases", &sol.mesh, &sol.features, &mapped.map.uv), (0, 0));
 }
 
 /// A feature curve that ends inside the surface is an isoline running on

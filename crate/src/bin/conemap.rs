@@ -5,6 +5,7 @@
 
 use conemap::cones::{self, BoundaryMode, ConeOptions, ConePlacement};
 use conemap::features::FeatureSet;
+use conemap::pipeline::GridFeatures;
 use conemap::mesh::{analyze_located, Located, RawMesh, TriMesh};
 use conemap::param::quantize::{GridSize, QuantizeOptions, QuantizeReport};
 use std::path::Path;
@@ -84,7 +85,7 @@ commands:
                        injective iterations) show on standard error while
                        it runs; --quiet turns that off.
 
-  solve FILE -o OUT [--alpha A] [--miq] [--quiet] [--sharp DEG] [--min-feature-length N|X%]
+  solve FILE -o OUT [--alpha A] [--miq] [--quiet] [--sharp DEG|none] [--min-feature-length N|X%]
              [--closed-features] [--features FEATURES.json]
              [--boundary aligned|free] [--max-cone-index K] [--no-moves] [--report REPORT.json] [--checker]
                        place cones, compute the seamless parametrization and
@@ -114,8 +115,15 @@ commands:
                        to follow (dangling branches and closed loops under
                        two cells) and the map that folds less is kept
                        (the report's dropped_feature_edges counts them).
+                       Without --sharp or --features, a grid map follows
+                       the mesh's creases (edges sharper than 75° on
+                       curves of at least 10 % of the bounding-box
+                       diagonal: a CAD part's edges, which quads cut across
+                       otherwise), all of them dropped where they fold the
+                       map (the report's detected_feature_edges counts
+                       them); --sharp none follows no crease.
 
-  quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG]
+  quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG|none]
              [--features FEATURES.json] [--report REPORT.json] [cone options]
                        the quad mesh of the integer-grid map (default
                        --quads 3000): OBJ with quad faces and the grid
@@ -133,6 +141,8 @@ commands:
                        themselves, and the map that folds less is kept
                        (a note and the report's dropped_feature_edges say
                        so; the sharp-edge figures still count them).
+                       Without --sharp or --features, creases are followed
+                       as for solve --grid (--sharp none: none).
 
 options:
   -h, --help           print this help
@@ -401,7 +411,8 @@ fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
         }
     };
     let filtering = min_length != MinLength::None || args.flag("--closed-features");
-    if let Some(deg) = args.number("--sharp")? {
+    let threshold = if args.value("--sharp") == Some("none") { None } else { args.number("--sharp")? };
+    if let Some(deg) = threshold {
         let found = detect_sharp(mesh, &SharpOptions { threshold_degrees: deg, min_length, prune_dangling: args.flag("--closed-features") });
         if filtering {
             let s = found.stats;
@@ -421,6 +432,28 @@ fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
         features.union(&given);
     }
     Ok(features)
+}
+
+/// The features of a grid map (`quads`, `solve --grid`): those of
+/// [`load_features`], or where neither `--sharp` nor `--features` is given,
+/// the creases of [`conemap::features::CREASES`], which the grid stage
+/// drops wherever they fold the map (`--sharp none`: no features).
+fn grid_features(args: &Args, mesh: &TriMesh) -> Result<GridFeatures, Failure> {
+    let asked = load_features(args, mesh)?;
+    if args.value("--sharp").is_some() || args.value("--features").is_some() {
+        return Ok(GridFeatures::asked(mesh, asked));
+    }
+    let creases = conemap::features::detect_sharp(mesh, &conemap::features::CREASES).features;
+    Ok(GridFeatures { all: creases.clone(), detected: creases })
+}
+
+/// The line that says which creases [`grid_features`] found, if any.
+fn print_detected_creases(detected: &FeatureSet, dropped: &FeatureSet) {
+    if detected.is_empty() {
+        return;
+    }
+    let kept = detected.without(dropped).len();
+    println!("  creases (no --sharp or --features given): {kept} of {} crease edges followed; --sharp none turns this off", detected.len());
 }
 
 /// Both stages' settings: [`cone_options`] and `--max-edge L|X%` (split
@@ -641,15 +674,18 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     let mut clock = conemap::clock::Stopwatch::start();
     let input_file = read_input(file)?;
     let mut times = SolveTimes { import: clock.lap(), ..SolveTimes::default() };
-    let features = load_features(args, &input_file.mesh)?;
+    let features = match grid {
+        Some(_) => grid_features(args, &input_file.mesh)?,
+        None => GridFeatures::asked(&input_file.mesh, load_features(args, &input_file.mesh)?),
+    };
     let mut options = solve_options(args, &input_file.mesh, None)?;
     if let Some(grid) = grid {
         options = options.for_quads(&input_file.mesh, grid);
     }
-    let mut solution = solve_mesh(args, file, &input_file.mesh, &features, &options)?;
+    let mut solution = solve_mesh(args, file, &input_file.mesh, &features.all, &options)?;
     times.cones = solution.refine_seconds + solution.placement.timings.total;
     times.param = clock.lap() - times.cones;
-    let (mut grid_map, mut dropped_features) = (None, 0);
+    let (mut grid_map, mut dropped_features) = (None, FeatureSet::none(&input_file.mesh));
     if let Some(size) = grid {
         // A map solved again on the refinement for quads (where the input's
         // grid map folds) counts as quantization time.
@@ -659,10 +695,10 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
         let mapped = conemap::pipeline::grid_map(&input_file.mesh, &features, &options, solution, size, &quantize, long_edges, &mut |p| bar.solve(p), &mut |_, _| {});
         bar.finish();
         let mapped = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
-        dropped_features = mapped.dropped_features.len();
+        dropped_features = mapped.dropped_features;
         (solution, grid_map) = (mapped.solution, Some(mapped.map));
     }
-    let alignment = solution.feature_alignment(&input_file.mesh, &features);
+    let alignment = solution.feature_alignment(&input_file.mesh, &features.all);
     times.quantize = clock.lap();
     let uv = grid_map.as_ref().map(|g| &g.uv).unwrap_or(&solution.param.uv);
 
@@ -695,14 +731,16 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
         let mut report = solve_report(&solution, &options.cones, &alignment, &written, &times);
         if let Some(g) = &grid_map {
             report["quantization"] = serde_json::json!(g.report);
-            report["dropped_feature_edges"] = serde_json::json!(dropped_features);
+            report["dropped_feature_edges"] = serde_json::json!(dropped_features.len());
+            report["detected_feature_edges"] = serde_json::json!(features.detected.len());
         }
         let text = serde_json::to_string_pretty(&report).map_err(|e| Failure(e.to_string(), 1))?;
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
     }
     print_solution(file, &solution, &alignment, &written, &times);
     if let Some(g) = &grid_map {
-        print_dropped_features(dropped_features);
+        print_dropped_features(dropped_features.without(&features.detected).len());
+        print_detected_creases(&features.detected, &dropped_features);
         print_quantization(&g.report);
     }
     Ok(())

@@ -42,6 +42,23 @@ pub enum LongEdges {
     RefineWhereFolded,
 }
 
+/// The feature edges of a grid map's solve: every one (`all`), and those
+/// of them found for the caller rather than asked for (`detected`: the
+/// creases of [`crate::features::CREASES`] where no features were given),
+/// which the stage drops together wherever they fold the map.
+#[derive(Clone, Debug)]
+pub struct GridFeatures {
+    pub all: FeatureSet,
+    pub detected: FeatureSet,
+}
+
+impl GridFeatures {
+    /// Only features asked for, of `mesh`'s edges.
+    pub fn asked(mesh: &TriMesh, features: FeatureSet) -> GridFeatures {
+        GridFeatures { all: features, detected: FeatureSet::none(mesh) }
+    }
+}
+
 /// A solved map kept for integer-grid maps of any size, with the maps
 /// solved again for earlier sizes (each kept while later sizes ask for the
 /// same thing, so that moving a quad-count slider re-runs only the
@@ -51,7 +68,7 @@ pub struct GridStage {
     base: Solved,
     /// The solve's features and settings, as solved (the low-poly
     /// fallback's maximum edge length included), to solve again with.
-    features: FeatureSet,
+    features: GridFeatures,
     options: SolveOptions,
     long_edges: LongEdges,
     /// The map solved again with these cut-vertex pairs of `base` cancelled.
@@ -104,16 +121,16 @@ struct Candidate {
 }
 
 impl GridStage {
-    /// The stage of `solution`, solved with `features` and `options`.
-    pub fn new(solution: Solution<'_>, features: FeatureSet, options: SolveOptions, long_edges: LongEdges) -> GridStage {
+    /// The stage of `solution`, solved with `features.all` and `options`.
+    pub fn new(solution: Solution<'_>, features: GridFeatures, options: SolveOptions, long_edges: LongEdges) -> GridStage {
         // As solved: a low-poly fallback's edge length is not asked again.
         let options = SolveOptions { refine: solution.refine_options, ..options };
         GridStage { base: Solved::new(solution.into_owned()), features, options, long_edges, paired: None, unfollowed: None }
     }
 
-    /// The features asked for (every one, the dropped ones too).
+    /// The features solved for (every one, the dropped ones too).
     pub fn features(&self) -> &FeatureSet {
-        &self.features
+        &self.features.all
     }
 
     /// The integer-grid map for `size` of the stage's map, solved on `input`
@@ -131,7 +148,9 @@ impl GridStage {
     ///    around) and some feature curves are finer than the grid
     ///    ([`finer_than_grid`]: short dangling branches and small loops,
     ///    whose corner cones the rounding must put on grid points a cell
-    ///    apart), it is solved again without them and kept if it folds less
+    ///    apart) or were detected rather than asked for
+    ///    ([`GridFeatures::detected`]: every one of them goes), it is
+    ///    solved again without them and kept if it folds less
     ///    (teapot with creases above 60° at 3 000 quads: the map winds
     ///    around 6 vertices with the spout's lip, none without it). A map
     ///    that follows every feature wins ties. With such curves the first
@@ -155,7 +174,7 @@ impl GridStage {
         // 1. The refinement, before any rounding.
         if self.long_edges == LongEdges::RefineFirst {
             if let Some(refine) = long_edges_refine(input, &self.options.refine, Some(size)) {
-                if let Some(solved) = self.solve_again(input, &self.features, refine, None, solve_progress) {
+                if let Some(solved) = self.solve_again(input, &self.features.all, refine, None, solve_progress) {
                     self.replace_base(solved);
                 }
                 self.options.refine = refine;
@@ -164,7 +183,8 @@ impl GridStage {
         // 2. Close cone pairs cancelled; with curves to drop, a hopeless
         // first rounding stops after its plain pass.
         let source = self.pair_cancelled(input, size, solve_progress);
-        let dropped = finer_than_grid(input, &self.features, quad_length(input, size));
+        let mut dropped = finer_than_grid(input, &self.features.all, quad_length(input, size));
+        dropped.union(&self.features.detected);
         let first = QuantizeOptions { plain_only_if_hopeless: !dropped.is_empty(), ..*quantize };
         let map = self.quantize(source, size, &first, progress)?;
         let mut best = Candidate { source, map, dropped: FeatureSet::none(input) };
@@ -172,7 +192,7 @@ impl GridStage {
         if best.map.report.folds() > 0 && self.long_edges == LongEdges::RefineWhereFolded {
             if let Some(refine) = long_edges_refine(input, &self.options.refine, Some(size)) {
                 self.options.refine = refine;
-                let again = self.solve_again(input, &self.features, refine, Some(size), solve_progress);
+                let again = self.solve_again(input, &self.features.all, refine, Some(size), solve_progress);
                 if let Some(mut solved) = again {
                     if let Ok(map) = solved.quantize(size, quantize, progress) {
                         if map.report.folds() < best.map.report.folds() {
@@ -186,7 +206,7 @@ impl GridStage {
         // 3. Without the curves finer than the grid, where the map folds.
         if best.map.report.folds() > 0 && !dropped.is_empty() {
             if self.unfollowed.as_ref().is_none_or(|u| u.key != dropped) {
-                let solved = self.solve_again(input, &self.features.without(&dropped), self.options.refine, Some(size), solve_progress);
+                let solved = self.solve_again(input, &self.features.all.without(&dropped), self.options.refine, Some(size), solve_progress);
                 self.unfollowed = Some(Resolved { key: dropped.clone(), solved });
             }
             if let Ok(map) = self.quantize(Source::Unfollowed, size, quantize, progress) {
@@ -226,7 +246,7 @@ impl GridStage {
             return Source::Base;
         }
         if self.paired.as_ref().is_none_or(|p| p.key != pairs) {
-            let solved = self.solve_again(input, &self.features, self.options.refine, Some(size), solve_progress);
+            let solved = self.solve_again(input, &self.features.all, self.options.refine, Some(size), solve_progress);
             self.paired = Some(Resolved { key: pairs, solved });
         }
         match &self.paired {
@@ -281,13 +301,13 @@ impl GridStage {
     }
 }
 
-/// The integer-grid map of `solution` (solved on `mesh` with `features`
+/// The integer-grid map of `solution` (solved on `mesh` with `features.all`
 /// and `options`) for `size`, as [`GridStage::map`] with `long_edges`, for
 /// a caller that asks once.
 #[allow(clippy::too_many_arguments)]
 pub fn grid_map(
     mesh: &TriMesh,
-    features: &FeatureSet,
+    features: &GridFeatures,
     options: &SolveOptions,
     solution: Solution<'_>,
     size: GridSize,

@@ -2,7 +2,7 @@
 //! and the quad mesh traced on it, written as OBJ (quads) or glTF (each quad
 //! as two triangles plus a LINES primitive of the quad edges).
 
-use super::{check_writable, cone_options, grid_option, load_features, read_input, solve_mesh, solve_options, usage, Args, Failure, ProgressLine};
+use super::{check_writable, cone_options, grid_features, grid_option, read_input, solve_mesh, solve_options, usage, Args, Failure, ProgressLine};
 use conemap::param::quantize::{GridSize, QuantizeOptions};
 use conemap::quads::{check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
 use std::path::Path;
@@ -26,10 +26,10 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let mut clock = conemap::clock::Stopwatch::start();
     let input = read_input(file)?;
     let import = clock.lap();
-    let features = load_features(args, &input.mesh)?;
+    let features = grid_features(args, &input.mesh)?;
     let max_edge = conemap::pipeline::RefineOptions::for_quads(&input.mesh, grid).max_edge_length;
     let options = solve_options(args, &input.mesh, max_edge)?.for_quads(&input.mesh, grid);
-    let solution = solve_mesh(args, file, &input.mesh, &features, &options)?;
+    let solution = solve_mesh(args, file, &input.mesh, &features.all, &options)?;
     let solve = clock.lap();
     // Solves again without the feature curves finer than the grid where
     // they fold the map (counted as quantization time).
@@ -41,8 +41,8 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let quantize_seconds = clock.lap();
     let quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let extract = clock.lap();
-    // Every feature asked for, the dropped ones too.
-    let sharp = solution.solved_edges_of(&features);
+    // Every feature solved for (detected creases too), the dropped ones too.
+    let sharp = solution.solved_edges_of(&features.all);
     let report = check_quads(&solution.mesh, &quads, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
     let check = clock.lap();
 
@@ -61,6 +61,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
             "output": {"path": out, "bytes": data.len()},
             "cones": solution.placement.cones.len(),
             "dropped_feature_edges": dropped_features.len(),
+            "detected_feature_edges": features.detected.len(),
             "distortion_seamless": solution.param.metrics.distortion,
             "quantization": map.report,
             "quads": report,
@@ -70,8 +71,9 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
         let text = serde_json::to_string_pretty(&json).map_err(|e| Failure(e.to_string(), 1))?;
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
     }
-    println!("{file}: {} vertices, {} faces, {} feature edges, {} cones", input.mesh.n_vertices(), input.mesh.n_faces(), features.len(), solution.placement.cones.len());
-    super::print_dropped_features(dropped_features.len());
+    println!("{file}: {} vertices, {} faces, {} feature edges, {} cones", input.mesh.n_vertices(), input.mesh.n_faces(), features.all.len(), solution.placement.cones.len());
+    super::print_dropped_features(dropped_features.without(&features.detected).len());
+    super::print_detected_creases(&features.detected, &dropped_features);
     super::print_quantization(&map.report);
     print_quads(&report, quads.defects.len());
     println!("  wrote {out}: {} quads, {} vertices", quads.n_quads(), quads.n_vertices());
