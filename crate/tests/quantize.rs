@@ -582,9 +582,10 @@ fn feature_curves_finer_than_the_grid_are_dropped_where_they_fold_the_map() {
 }
 
 /// Creases found for a caller that gave no features (`features::CREASES`,
-/// as `quads` finds them) are dropped together wherever they fold the map:
-/// cow's 32 edges above 75° on long curves (ears, horns) fold its map at
-/// 1 000 quads, so it is solved again without any of them, with no fold.
+/// as `quads` finds them) are dropped on the components where they fold
+/// the map: cow's 32 edges above 75° on long curves (ears, horns) fold its
+/// map at 1 000 quads, so it is solved again without any of them, with no
+/// fold. (`pipeline::grid`'s unit test: a fold marks its own component's.)
 #[test]
 fn detected_creases_are_dropped_where_they_fold_the_map() {
     use conemap::features::{detect_sharp, CREASES};

@@ -119,8 +119,8 @@ commands:
                        the mesh's creases (edges sharper than 75° on
                        curves of at least 10 % of the bounding-box
                        diagonal: a CAD part's edges, which quads cut across
-                       otherwise), all of them dropped where they fold the
-                       map (the report's detected_feature_edges counts
+                       otherwise), dropped on each part where they fold
+                       the map (the report's detected_feature_edges counts
                        them); --sharp none follows no crease.
 
   quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG|none]
@@ -437,7 +437,7 @@ fn load_features(args: &Args, mesh: &TriMesh) -> Result<FeatureSet, Failure> {
 /// The features of a grid map (`quads`, `solve --grid`): those of
 /// [`load_features`], or where neither `--sharp` nor `--features` is given,
 /// the creases of [`conemap::features::CREASES`], which the grid stage
-/// drops wherever they fold the map (`--sharp none`: no features).
+/// drops on the components where they fold the map (`--sharp none`: none).
 fn grid_features(args: &Args, mesh: &TriMesh) -> Result<GridFeatures, Failure> {
     let asked = load_features(args, mesh)?;
     if args.value("--sharp").is_some() || args.value("--features").is_some() {

@@ -359,6 +359,9 @@ impl QuantizeReport {
 pub struct IntegerGridMap {
     pub uv: Vec<[f64; 2]>,
     pub report: QuantizeReport,
+    /// Where the map folds ([`QuantizeReport::folds`]): the flipped
+    /// triangles and a triangle at each vertex it winds around, ascending.
+    pub fold_faces: Vec<u32>,
 }
 
 /// The fixed part of quantization for one parametrization: unknowns,
@@ -559,7 +562,17 @@ impl Quantizer {
                 }
             }
         }
-        let flipped = self.flipped(&x);
+        let inverted = local::inverted_faces(&self.elements, &x);
+        let wound = self.wound_vertices(&x);
+        let mut fold_faces: Vec<u32> = inverted.iter().map(|&f| f as u32).collect();
+        let mut wound_left: std::collections::HashSet<u32> = wound.iter().copied().collect();
+        for (f, t) in self.faces.iter().enumerate() {
+            if t.iter().any(|v| wound_left.remove(v)) {
+                fold_faces.push(f as u32);
+            }
+        }
+        fold_faces.sort_unstable();
+        fold_faces.dedup();
         let mut conflicts = 0;
         let mut integer_residual = 0.0f64;
         for (form, value) in self.forms.iter().zip(&values) {
@@ -611,13 +624,13 @@ impl Quantizer {
             integer_residual,
             distortion_before: self.distortion_before,
             distortion_after: metrics::distortion(mesh, &uv),
-            flipped,
-            wound_vertices: self.wound_vertices(&x).len(),
+            flipped: inverted.len(),
+            wound_vertices: wound.len(),
             cells,
             passes_skipped,
             seconds: clock.lap(),
         };
-        Ok(IntegerGridMap { uv, report })
+        Ok(IntegerGridMap { uv, report, fold_faces })
     }
 
     /// The rounding at grid length `s` kept of the passes, each run only

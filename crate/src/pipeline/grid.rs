@@ -45,7 +45,7 @@ pub enum LongEdges {
 /// The feature edges of a grid map's solve: every one (`all`), and those
 /// of them found for the caller rather than asked for (`detected`: the
 /// creases of [`crate::features::CREASES`] where no features were given),
-/// which the stage drops together wherever they fold the map.
+/// which the stage drops on each component where the map folds.
 #[derive(Clone, Debug)]
 pub struct GridFeatures {
     pub all: FeatureSet,
@@ -149,8 +149,9 @@ impl GridStage {
     ///    ([`finer_than_grid`]: short dangling branches and small loops,
     ///    whose corner cones the rounding must put on grid points a cell
     ///    apart) or were detected rather than asked for
-    ///    ([`GridFeatures::detected`]: every one of them goes), it is
-    ///    solved again without them and kept if it folds less
+    ///    ([`GridFeatures::detected`]: every one on a component where the
+    ///    map folds goes), it is solved again without them and kept if it
+    ///    folds less
     ///    (teapot with creases above 60° at 3 000 quads: the map winds
     ///    around 6 vertices with the spout's lip, none without it). A map
     ///    that follows every feature wins ties. With such curves the first
@@ -184,8 +185,8 @@ impl GridStage {
         // first rounding stops after its plain pass.
         let source = self.pair_cancelled(input, size, solve_progress);
         let mut dropped = finer_than_grid(input, &self.features.all, quad_length(input, size));
-        dropped.union(&self.features.detected);
-        let first = QuantizeOptions { plain_only_if_hopeless: !dropped.is_empty(), ..*quantize };
+        let droppable = !dropped.is_empty() || !self.features.detected.is_empty();
+        let first = QuantizeOptions { plain_only_if_hopeless: droppable, ..*quantize };
         let map = self.quantize(source, size, &first, progress)?;
         let mut best = Candidate { source, map, dropped: FeatureSet::none(input) };
         // 1. The refinement, where the map folds.
@@ -203,7 +204,11 @@ impl GridStage {
                 }
             }
         }
-        // 3. Without the curves finer than the grid, where the map folds.
+        // 3. Without the curves finer than the grid and the detected creases
+        // of the components where the map folds.
+        if best.map.report.folds() > 0 {
+            dropped.union(&self.detected_where_folded(input, &best));
+        }
         if best.map.report.folds() > 0 && !dropped.is_empty() {
             if self.unfollowed.as_ref().is_none_or(|u| u.key != dropped) {
                 let solved = self.solve_again(input, &self.features.all.without(&dropped), self.options.refine, Some(size), solve_progress);
@@ -229,6 +234,14 @@ impl GridStage {
         };
         let solution = &self.solved(best.source).expect("a candidate's map exists").solution;
         Ok(GridMapped { solution, map: best.map, dropped_features: best.dropped, cancelled_pairs })
+    }
+
+    /// The detected creases ([`GridFeatures::detected`]) on the components
+    /// of `input` where `candidate`'s map folds.
+    fn detected_where_folded(&self, input: &TriMesh, candidate: &Candidate) -> FeatureSet {
+        let solution = &self.solved(candidate.source).expect("a candidate's map exists").solution;
+        let folded = candidate.map.fold_faces.iter().map(|&f| solution.original_face.as_ref().map_or(f, |original| original[f as usize]));
+        on_components_of(input, folded, &self.features.detected)
     }
 
     /// The map to round for `size` (step 2 of [`Self::map`]): the map solved
@@ -301,6 +314,19 @@ impl GridStage {
     }
 }
 
+/// The edges of `features` on the components of `mesh` that hold one of `faces`.
+fn on_components_of(mesh: &TriMesh, faces: impl Iterator<Item = u32>, features: &FeatureSet) -> FeatureSet {
+    let mut marked = vec![false; mesh.n_components()];
+    for f in faces {
+        marked[mesh.face_components()[f as usize] as usize] = true;
+    }
+    let mut on = FeatureSet::none(mesh);
+    for e in features.edges() {
+        on.set(mesh, e, marked[mesh.vertex_component(mesh.edge_vertices(e)[0])]);
+    }
+    on
+}
+
 /// The integer-grid map of `solution` (solved on `mesh` with `features.all`
 /// and `options`) for `size`, as [`GridStage::map`] with `long_edges`, for
 /// a caller that asks once.
@@ -320,4 +346,31 @@ pub fn grid_map(
     let GridMapped { solution, map, dropped_features, cancelled_pairs } = stage.map(mesh, size, quantize, solve_progress, progress)?;
     // (A copy of the mesh and map: milliseconds beside the solve.)
     Ok(GridMapped { solution: solution.clone(), map, dropped_features, cancelled_pairs })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two blocks side by side: a fold on one of them marks its edges only.
+    #[test]
+    fn folds_mark_the_features_of_their_own_component() {
+        let mut raw = crate::mesh::shapes::voxel_block(2, 1, 1, &[]);
+        let n = raw.positions.len() as u32;
+        let moved: Vec<[f64; 3]> = raw.positions.iter().map(|p| [p[0] + 5.0, p[1], p[2]]).collect();
+        let faces: Vec<[u32; 3]> = raw.triangles.iter().map(|t| t.map(|v| v + n)).collect();
+        raw.positions.extend(moved);
+        raw.triangles.extend(faces);
+        let mesh = TriMesh::from_raw(&raw).unwrap();
+        let edges = FeatureSet::sharp_edges(&mesh, 60.0);
+        assert_eq!((mesh.n_components(), edges.len()), (2, 2 * 16));
+        let first = mesh.face_components()[0];
+        let on_first = |f: u32| mesh.face_components()[f as usize] == first;
+        let (a, b) = ((0..mesh.n_faces() as u32).find(|&f| on_first(f)).unwrap(), (0..mesh.n_faces() as u32).find(|&f| !on_first(f)).unwrap());
+        let marked = on_components_of(&mesh, [a, a].into_iter(), &edges);
+        assert_eq!(marked.len(), 16);
+        assert!(marked.edges().all(|e| mesh.vertex_component(mesh.edge_vertices(e)[0]) == first as usize));
+        assert_eq!(on_components_of(&mesh, [a, b].into_iter(), &edges), edges);
+        assert!(on_components_of(&mesh, std::iter::empty(), &edges).is_empty());
+    }
 }

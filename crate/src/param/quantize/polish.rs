@@ -448,11 +448,6 @@ impl Quantizer {
             })
             .collect()
     }
-
-    /// Triangles of `x` flipped or degenerate ([`local::inverted_faces`]).
-    pub(super) fn flipped(&self, x: &[f64]) -> usize {
-        local::inverted_faces(&self.elements, x).len()
-    }
 }
 
 /// A rounded map with integers moved off its collapses, polished
