@@ -41,11 +41,11 @@ impl SharpOptions {
 /// The creases a grid map follows where the caller gives no features
 /// (`quads`, `solve --grid`): edges sharper than 75° on curves at least
 /// 10 % of the bounding-box diagonal long, dropped on the components where
-/// they fold the map ([`crate::pipeline::GridFeatures`]). A crease of angle θ that a cell
-/// of size `s` crosses is cut off by up to about s·sin(θ/2) (0.6 s at 75°):
-/// at 3 000 quads a cell is about 2 % of a part's diagonal, so a CAD part's
-/// 90° creases cut across put the quads 1.0-1.4 % of the diagonal from it
-/// (fandisk 1.36 %; followed, 0.72 %). Lower thresholds and shorter curves
+/// they fold the map ([`crate::pipeline::GridFeatures`]). A crease of
+/// angle θ that a cell of size `s` crosses is cut off by up to about
+/// s·sin(θ/2) (0.6 s at 75°): at 3 000 quads a cell is about 2 % of a
+/// part's diagonal, so a CAD part's 90° creases cut across put the quads
+/// 1.0-1.9 % of the diagonal from it (fandisk 1.36 %; followed, 0.72 %). Lower thresholds and shorter curves
 /// catch the curvature of coarse organic meshes (above 60° on curves this
 /// long: cow 97 edges, whose map then folds at 3 000 quads, and bff-face
 /// 32, whose quads then lie 1.49 % of the diagonal from it against 0.75 %;
