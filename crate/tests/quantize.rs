@@ -598,7 +598,7 @@ fn detected_creases_are_dropped_where_they_fold_the_map() {
     let solution = solve(&input, &creases, &options, &mut |_| {}).unwrap();
     let first = solution.quantizer().unwrap().quantize(&solution.mesh, size, &mut |_, _| {}).unwrap();
     assert!(first.report.folds() > 0, "the map with the creases no longer folds: this test no longer exercises the fallback");
-    let features = GridFeatures { all: creases.clone(), detected: creases.clone() };
+    let features = GridFeatures::detected(creases.clone());
     let mut stage = GridStage::new(solution, features, options, LongEdges::RefineFirst);
     let mapped = stage.map(&input, size, &QuantizeOptions::default(), &mut |_| {}, &mut |_, _| {}).unwrap();
     assert_eq!(mapped.dropped_features, creases, "every detected crease goes");

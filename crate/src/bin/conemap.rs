@@ -444,17 +444,9 @@ fn grid_features(args: &Args, mesh: &TriMesh) -> Result<GridFeatures, Failure> {
         return Ok(GridFeatures::asked(mesh, asked));
     }
     let creases = conemap::features::detect_sharp(mesh, &conemap::features::CREASES).features;
-    Ok(GridFeatures { all: creases.clone(), detected: creases })
+    Ok(GridFeatures::detected(creases))
 }
 
-/// The line that says which creases [`grid_features`] found, if any.
-fn print_detected_creases(detected: &FeatureSet, dropped: &FeatureSet) {
-    if detected.is_empty() {
-        return;
-    }
-    let kept = detected.without(dropped).len();
-    println!("  creases (no --sharp or --features given): {kept} of {} crease edges followed; --sharp none turns this off", detected.len());
-}
 
 /// Both stages' settings: [`cone_options`] and `--max-edge L|X%` (split
 /// edges longer than L model units, or X % of `mesh`'s bounding-box
@@ -739,8 +731,7 @@ fn solve_command(args: &Args) -> Result<(), Failure> {
     }
     print_solution(file, &solution, &alignment, &written, &times);
     if let Some(g) = &grid_map {
-        print_dropped_features(dropped_features.without(&features.detected).len());
-        print_detected_creases(&features.detected, &dropped_features);
+        print_dropped_features(&features, &dropped_features);
         print_quantization(&g.report);
     }
     Ok(())
@@ -776,14 +767,20 @@ fn grid_option(args: &Args, flag: &str) -> Result<Option<GridSize>, Failure> {
     }
 }
 
-/// The note on the feature edges a grid map was solved without
-/// ([`conemap::pipeline::grid_map`]), if any.
-fn print_dropped_features(dropped: usize) {
-    if dropped > 0 {
+/// The notes on the feature edges a grid map was solved without
+/// ([`conemap::pipeline::grid_map`]) and on the creases it detected, if any.
+fn print_dropped_features(features: &GridFeatures, dropped: &FeatureSet) {
+    let detected = &features.detected;
+    let asked = dropped.without(detected).len();
+    if asked > 0 {
         println!(
-            "  note: the map with every feature folds; solved without {dropped} feature edges the grid is too coarse to follow (branches and loops under {} quads); a smaller grid keeps them",
+            "  note: the map with every feature folds; solved without {asked} feature edges the grid is too coarse to follow (branches and loops under {} quads); a smaller grid keeps them",
             conemap::features::grid::MIN_CURVE_CELLS
         );
+    }
+    if !detected.is_empty() {
+        let kept = detected.without(dropped).len();
+        println!("  creases (no --sharp or --features given): {kept} of {} crease edges followed; --sharp none turns this off", detected.len());
     }
 }
 

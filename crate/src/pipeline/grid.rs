@@ -57,6 +57,11 @@ impl GridFeatures {
     pub fn asked(mesh: &TriMesh, features: FeatureSet) -> GridFeatures {
         GridFeatures { all: features, detected: FeatureSet::none(mesh) }
     }
+
+    /// Only creases found for the caller (every one droppable).
+    pub fn detected(creases: FeatureSet) -> GridFeatures {
+        GridFeatures { all: creases.clone(), detected: creases }
+    }
 }
 
 /// A solved map kept for integer-grid maps of any size, with the maps

@@ -72,8 +72,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
     }
     println!("{file}: {} vertices, {} faces, {} feature edges, {} cones", input.mesh.n_vertices(), input.mesh.n_faces(), features.all.len(), solution.placement.cones.len());
-    super::print_dropped_features(dropped_features.without(&features.detected).len());
-    super::print_detected_creases(&features.detected, &dropped_features);
+    super::print_dropped_features(&features, &dropped_features);
     super::print_quantization(&map.report);
     print_quads(&report, quads.defects.len());
     println!("  wrote {out}: {} quads, {} vertices", quads.n_quads(), quads.n_vertices());
