@@ -78,6 +78,8 @@ pub struct MeshSession {
 /// components placed so far.
 struct Job {
     features: FeatureSet,
+    /// Those of `features` found as creases (see `solve_begin`).
+    creases: FeatureSet,
     options: SolveOptions,
     stage: SolveStage,
     placed: Vec<ComponentPlacement>,
@@ -185,10 +187,25 @@ impl MeshSession {
         let mesh = self.valid_mesh()?;
         let min_length = if min_edges > 0 { MinLength::Edges(min_edges as usize) } else { MinLength::None };
         let found = detect_sharp(mesh, &SharpOptions { threshold_degrees: degrees, min_length, prune_dangling: closed_only });
-        let edges: Vec<u32> = found.features.edges().collect();
-        let out = Object::new();
-        set(&out, "edges", &Uint32Array::from(&edges[..]).into())?;
-        set(&out, "stats", &to_js(&found.stats)?)?;
+        Ok(detection_object(&found)?.into())
+    }
+
+    /// The creases `conemap quads` follows where no features are given
+    /// ([`crate::features::CREASES`]): `{ edges, stats }` as `sharp_curves`
+    /// plus `degrees` (the threshold) and `min_length_fraction` (the
+    /// shortest curve kept, a fraction of the bounding-box diagonal). Pass
+    /// them to `solve_begin` as `creases` too, so that the grid map drops
+    /// them where they fold it, as the CLI does.
+    pub fn crease_edges(&self) -> Result<JsValue, JsError> {
+        use crate::features::{detect_sharp, MinLength, CREASES};
+        let found = detect_sharp(self.valid_mesh()?, &CREASES);
+        let out = detection_object(&found)?;
+        set(&out, "degrees", &CREASES.threshold_degrees.into())?;
+        let fraction = match CREASES.min_length {
+            MinLength::DiagonalFraction(f) => f,
+            MinLength::None | MinLength::Edges(_) => 0.0,
+        };
+        set(&out, "min_length_fraction", &fraction.into())?;
         Ok(out.into())
     }
 
@@ -229,7 +246,7 @@ impl MeshSession {
     /// metrics and the exports of the solved mesh. Solve errors throw as
     /// `solve_finish` says.
     pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: Option<f64>, miq: bool, progress: &Function) -> Result<JsValue, JsValue> {
-        let schedule = self.solve_begin(feature_edges, alpha_smooth, miq)?;
+        let schedule = self.solve_begin(feature_edges, alpha_smooth, miq, None)?;
         for c in schedule {
             self.solve_place(c, false, progress)?;
         }
@@ -242,14 +259,18 @@ impl MeshSession {
     /// `solve_finish`. Starts a solve (dropping any unfinished one); returns
     /// the components in the order to place them (largest first).
     /// `alpha_smooth` undefined: [`default_alpha`] of `miq`, as the CLI.
-    pub fn solve_begin(&mut self, feature_edges: &[u32], alpha_smooth: Option<f64>, miq: bool) -> Result<Vec<u32>, JsError> {
+    /// `creases` (undefined: none): those of the feature edges that
+    /// `crease_edges` found rather than the user marked; `quads` drops them
+    /// on each component where they fold the map ([`GridFeatures`]).
+    pub fn solve_begin(&mut self, feature_edges: &[u32], alpha_smooth: Option<f64>, miq: bool, creases: Option<Vec<u32>>) -> Result<Vec<u32>, JsError> {
         self.job = None;
         self.grid = None;
         let (mesh, features, cones) = self.request(feature_edges, alpha_smooth, miq)?;
+        let creases = self.features(mesh, creases.as_deref().unwrap_or_default())?;
         let options = SolveOptions { cones, param: ParamOptions::default(), refine: self.refine };
         let stage = SolveStage::new(mesh, &features, &options);
         let schedule = stage.schedule().iter().map(|&c| c as u32).collect();
-        self.job = Some(Job { features, options, stage, placed: Vec::new() });
+        self.job = Some(Job { features, creases, options, stage, placed: Vec::new() });
         Ok(schedule)
     }
 
@@ -285,13 +306,13 @@ impl MeshSession {
     /// solve error's message and, where it names mesh elements, `location:
     /// {vertices: number[], edges: number[]}` in input ids ([`solve_error`]).
     pub fn solve_finish(&mut self, progress: &Function) -> Result<JsValue, JsValue> {
-        let Job { features, options, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
+        let Job { features, creases, options, stage, placed } = self.job.take().ok_or_else(|| JsError::new("no solve was started"))?;
         let mesh = self.valid_mesh()?;
         let fail = |e: SolveError| solve_error(&e);
         let sol = stage.finish(mesh, &features, placed, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
         // (The stage keeps the settings as solved: a low-poly fallback's edge length is not asked again.)
-        self.grid = Some(GridStage::new(sol.into_owned(), GridFeatures::asked(mesh, features), options, LongEdges::RefineFirst));
+        self.grid = Some(GridStage::new(sol.into_owned(), GridFeatures::with_creases(features, &creases), options, LongEdges::RefineFirst));
         Ok(result)
     }
 
@@ -321,6 +342,7 @@ impl MeshSession {
         let size = GridSize::Quads(quads as usize);
         // Every feature asked for, the dropped ones too (the map borrows the stage).
         let requested = grid.features().clone();
+        let creases = grid.detected_features().clone();
         let quantizing = &mut |done, total| notify(progress, "quantization", done, total, None);
         let mapped = grid.map(input, size, &QuantizeOptions::default(), &mut solve_progress(progress), quantizing);
         let GridMapped { solution: sol, map, dropped_features: dropped, cancelled_pairs } = mapped.map_err(|e| JsError::new(&e.to_string()))?;
@@ -348,6 +370,7 @@ impl MeshSession {
             cones: sol.placement.cones.len(),
             cancelled_pairs,
             dropped_feature_edges: dropped.len(),
+            dropped_crease_edges: dropped.intersection(&creases).len(),
             solved_faces: sol.mesh.n_faces(),
             inserted_vertices: sol.splits,
             refinement: &sol.refinement,
@@ -593,8 +616,10 @@ struct QuadsResult<'a> {
     cones: usize,
     cancelled_pairs: usize,
     /// The input's feature edges the map was solved without, where the map
-    /// with all of them folded ([`finer_than_grid`]; 0: every feature kept).
+    /// with all of them folded ([`GridStage::map`]; 0: every feature kept),
+    /// and how many of them were creases (`solve_begin`'s `creases`).
     dropped_feature_edges: usize,
+    dropped_crease_edges: usize,
     /// The mesh the map was solved on: its faces, the vertices inserted into
     /// the input, and why ([`pipeline::long_edges_refine`] may have refined it).
     solved_faces: usize,
@@ -623,6 +648,15 @@ struct SolveMetrics<'a> {
 fn to_js<T: Serialize>(value: &T) -> Result<JsValue, JsError> {
     let serializer = serde_wasm_bindgen::Serializer::new().serialize_maps_as_objects(true);
     value.serialize(&serializer).map_err(|e| JsError::new(&e.to_string()))
+}
+
+/// `{ edges: Uint32Array, stats }` of a sharp-edge detection.
+fn detection_object(found: &crate::features::SharpDetection) -> Result<Object, JsError> {
+    let edges: Vec<u32> = found.features.edges().collect();
+    let out = Object::new();
+    set(&out, "edges", &Uint32Array::from(&edges[..]).into())?;
+    set(&out, "stats", &to_js(&found.stats)?)?;
+    Ok(out)
 }
 
 fn input_files(files: &Array) -> Result<Vec<InputFile>, JsError> {

@@ -2,7 +2,7 @@
 // the edge under the pointer is highlighted before a click toggles it, a click
 // away from every edge toggles nothing, the Shift-click path says what comes
 // next, undo restores the sharp-edge controls with the edges, a slider drag
-// is one undo step, features round-trip through a JSON file, MIQ emulation
+// is one undo step, the creases preset marks the CLI's creases, features round-trip through a JSON file, MIQ emulation
 // sets α to 100, and Escape cancels a running solve.
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -151,6 +151,31 @@ describe('feature editing and the keyboard', () => {
     await page.getByTestId('undo').click();
     assert.equal((await hooks()).features, at90, 'one undo takes back the whole drag');
     assert.deepEqual(await sharpControls(), { on: true, angle: '90', shown: '90°', enabled: true });
+    await page.getByTestId('clear-features').click();
+    assert.equal((await hooks()).features, 0);
+  });
+
+  it('marks the creases conemap quads follows in one undo step, shown as the sharp-edge controls; a hand toggle keeps the rest', async () => {
+    await page.getByTestId('creases-button').click();
+    await waitFeatures(693);
+    assert.deepEqual(await sharpControls(), { on: true, angle: '75', shown: '75°', enabled: true });
+    assert.match(await page.getByTestId('sharp-stats').innerText(), /^Creases: 693 edges on 1 curve \(> 75°, at least 10 % of the diagonal long\), 0 shorter curves dropped/);
+    // Again: nothing changes, no second undo step.
+    await page.getByTestId('creases-button').click();
+    await page.evaluate(() => new Promise((res) => setTimeout(res, 300)));
+    await page.getByTestId('undo').click();
+    assert.equal((await hooks()).features, 0, 'one undo takes the creases back');
+    assert.equal((await sharpControls()).on, false);
+    assert.equal(await page.getByTestId('sharp-stats').innerText(), '');
+    await page.getByTestId('redo').click();
+    assert.equal((await hooks()).features, 693);
+    assert.deepEqual(await sharpControls(), { on: true, angle: '75', shown: '75°', enabled: true });
+    // Moving the slider replaces the creases by the plain threshold's edges.
+    await page.getByTestId('sharp-angle').fill('60');
+    await page.waitForFunction(() => window.__conemap.features > 693, null, { timeout: 10_000 });
+    assert.match(await page.getByTestId('sharp-stats').innerText(), /^\d+ sharp edges: /);
+    await page.getByTestId('undo').click();
+    assert.equal((await hooks()).features, 693);
     await page.getByTestId('clear-features').click();
     assert.equal((await hooks()).features, 0);
   });

@@ -1,7 +1,9 @@
 // End-to-end test of the quad mode of the built page (dist/) in headless
 // Chromium via playwright-core: the fandisk with its sharp edges solved, then
 // the quads of the map at a count set on the slider, their figures, legend,
-// overlay, the grid map in the UV view and the downloads. Run after `npm run build`.
+// overlay, the grid map in the UV view and the downloads; a low-poly CAD
+// cylinder; the fandisk's creases marked with the Creases button followed by
+// the quads. Run after `npm run build`.
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
@@ -212,6 +214,24 @@ describe('quad mode', () => {
     assert.equal(h.quads.defects, 0);
     assert.equal(h.quads.uvCorners, 3 * (4 * n - 4), 'grid UVs on the input corners');
     assert.match(await page.getByTestId('quad-stats').innerText(), /Solved on\s+[\d,]+ triangles \(long edges split for quads\)/);
+  });
+
+  it('follows the creases of the fandisk marked with the Creases button, as conemap quads does', async () => {
+    await page.goto(server.url);
+    await page.waitForFunction(() => window.__conemap && window.__conemap.loads > 0 && window.__conemap.state === 'ready', null, { timeout: LOAD_TIMEOUT });
+    await page.getByTestId('creases-button').click();
+    await page.waitForFunction(() => window.__conemap.features === 693, null, { timeout: 10_000 });
+    await page.getByTestId('run').click();
+    await page.waitForFunction(() => window.__conemap.solves > 0, null, { timeout: SOLVE_TIMEOUT });
+    await page.getByTestId('quad-mode').check();
+    const h = await waitForQuads(0);
+    const q = h.quads;
+    assert.ok(q, h.quadsError ?? '');
+    assert.equal(q.target, 3000);
+    assert.equal(q.droppedCreases, 0, 'the creases are followed at 3 000 quads');
+    assert.equal(q.defects, 0);
+    assert.ok(q.sharpWithin > 0.99, `${q.sharpWithin} of the sharp edges near a quad edge`);
+    assert.ok(q.distance < 0.01, `distance ${q.distance} of the diagonal`);
   });
 
   it('logged no unexpected console errors', () => {

@@ -149,6 +149,30 @@ test('quads drop the feature curves finer than the grid where the map with them 
   assert.equal(r2.report.quads, r.report.quads);
 });
 
+test('crease_edges are the creases conemap quads follows; quads drop them where they fold the map, unlike marked edges', () => {
+  const fandisk = open(committedFandisk).crease_edges();
+  assert.equal(fandisk.degrees, 75);
+  assert.equal(fandisk.min_length_fraction, 0.1);
+  assert.ok(fandisk.edges instanceof Uint32Array);
+  assert.equal(fandisk.edges.length, 693, 'the 693 crease edges conemap quads reports for the fandisk');
+  assert.deepEqual(fandisk.stats, { sharp_edges: 693, curves: 1, kept_edges: 693, dropped_fragments: 0, pruned_edges: 0 });
+  // The cow's 32 crease edges fold its map at 1 000 quads: passed as
+  // creases they all go (as in the CLI); passed only as features, only
+  // curves finer than the grid would (1 edge), and the map folds.
+  const session = open(sharedMesh('cow'));
+  const creases = session.crease_edges().edges;
+  assert.equal(creases.length, 32);
+  const edges = session.edges().length / 2;
+  assert.throws(() => session.solve_begin(creases, undefined, false, Uint32Array.of(edges)), /feature edge id \d+ is out of range/);
+  for (const c of session.solve_begin(creases, undefined, false, creases)) session.solve_place(c, false, () => {});
+  session.solve_finish(() => {});
+  const r = session.quads(1000, () => {});
+  assert.equal(r.dropped_crease_edges, 32);
+  assert.equal(r.dropped_feature_edges, 32);
+  assert.equal(r.quantization.flipped + r.quantization.wound_vertices, 0, 'the map without the creases does not fold');
+  assert.equal(r.defects, 0);
+});
+
 test('quads of a game asset of 56 parts: every part rounded on its own, the quad mesh closed', () => {
   const session = open(sharedMesh('xatlas-gazebo'));
   session.solve(new Uint32Array(), undefined, false, () => {});

@@ -1,14 +1,14 @@
 // Feature editing on the open mesh: the edge under the pointer highlighted and
 // a click toggling it, Shift-click two vertices to mark the shortest path
 // between them, the sharp-edge detection controls (a slider drag is one undo
-// step), undo / redo / clear (buttons and keys, the detection settings with
+// step) and the creases preset, undo / redo / clear (buttons and keys, the detection settings with
 // the edges), features import and export as JSON; and the queries of the
 // open mesh's geometry the test hooks answer with.
 import { $, fmtInt } from './dom';
 import { download, fileStem } from './downloads';
 import { FeatureSet, type SharpSettings } from './features';
 import { COLORS } from './palette';
-import type { ImportResult } from './protocol';
+import type { CreaseResult, ImportResult, SharpResult } from './protocol';
 import { latestPerFrame, onClick } from './render-loop';
 import type { Hooks } from './test-hooks';
 import { type Adjacency, shortestPath } from './topology';
@@ -45,6 +45,8 @@ export class FeatureEditor {
   private hovered = -1;
   /** Sharp-edge requests run one after the other, in order. */
   private sharpQueue: Promise<void> = Promise.resolve();
+  /** The settings the detection controls were last set to (a preset's stay in use until a control changes). */
+  private shown: SharpSettings | null = null;
   private readonly el = {
     count: $('feature-count'),
     boundaryCount: $('boundary-count'),
@@ -54,6 +56,7 @@ export class FeatureEditor {
     sharpMinEdges: $<HTMLInputElement>('sharp-min-edges'),
     sharpClosed: $<HTMLInputElement>('sharp-closed'),
     sharpStats: $<HTMLElement>('sharp-stats'),
+    creases: $<HTMLButtonElement>('creases-button'),
     hint: $<HTMLElement>('feature-hint'),
     importInput: $<HTMLInputElement>('features-file'),
     exportButton: $<HTMLButtonElement>('export-features'),
@@ -99,6 +102,7 @@ export class FeatureEditor {
   /** Shows detection `settings` in the controls (null: off, the other controls disabled). */
   private showSharpSettings(settings: SharpSettings | null): void {
     const el = this.el;
+    this.shown = settings;
     el.sharpToggle.checked = settings !== null;
     if (settings) {
       el.sharpAngle.value = String(settings.degrees);
@@ -115,12 +119,28 @@ export class FeatureEditor {
     this.el.sharpAngle.setAttribute('aria-valuetext', `${this.el.sharpAngle.value} degrees`);
   }
 
-  /** The detection settings the controls show (null: detection off). */
+  /** The detection settings the controls show (null: detection off); the creases preset's while no control changed since it was chosen. */
   private controlSettings(): SharpSettings | null {
     const el = this.el;
     if (!el.sharpToggle.checked) return null;
     const minEdges = Math.max(0, Math.floor(Number(el.sharpMinEdges.value) || 0));
-    return { degrees: Number(el.sharpAngle.value), minEdges, closedOnly: el.sharpClosed.checked };
+    const settings: SharpSettings = { degrees: Number(el.sharpAngle.value), minEdges, closedOnly: el.sharpClosed.checked };
+    const preset = this.shown;
+    const unchanged = preset?.creases && preset.degrees === settings.degrees && preset.minEdges === settings.minEdges && preset.closedOnly === settings.closedOnly;
+    return unchanged ? preset : settings;
+  }
+
+  /** Says what a detection with `settings` found. */
+  private showStats(settings: SharpSettings, found: SharpResult | CreaseResult): void {
+    const n = (k: number, one: string, many: string) => `${k} ${k === 1 ? one : many}`;
+    const { stats } = found;
+    if (settings.creases && 'min_length_fraction' in found) {
+      const percent = Math.round(100 * found.min_length_fraction);
+      this.el.sharpStats.textContent = `Creases: ${n(stats.kept_edges, 'edge', 'edges')} on ${n(stats.curves, 'curve', 'curves')} (> ${found.degrees}°, at least ${percent} % of the diagonal long), ${n(stats.dropped_fragments, 'shorter curve', 'shorter curves')} dropped; the quads drop them where they fold the map`;
+      return;
+    }
+    const pruned = stats.pruned_edges ? `, ${n(stats.pruned_edges, 'dangling edge', 'dangling edges')}` : '';
+    this.el.sharpStats.textContent = `${n(stats.sharp_edges, 'sharp edge', 'sharp edges')}: ${n(stats.curves, 'curve', 'curves')} (${n(stats.kept_edges, 'edge', 'edges')}) kept, ${n(stats.dropped_fragments, 'fragment', 'fragments')}${pruned} dropped`;
   }
 
   private redraw(): void {
@@ -141,6 +161,7 @@ export class FeatureEditor {
     this.el.redo.disabled = !f?.canRedo;
     this.el.clear.disabled = !f || n === 0;
     this.el.sharpToggle.disabled = !f;
+    this.el.creases.disabled = !f;
     this.el.exportButton.disabled = !f || n === 0;
     const importLabel = this.el.importInput.labels?.[0];
     this.el.importInput.disabled = !f;
@@ -241,15 +262,38 @@ export class FeatureEditor {
       return;
     }
     try {
-      const { edges, stats } = await this.worker.sharpEdges(settings.degrees, settings.minEdges, settings.closedOnly);
+      const found = settings.creases
+        ? await this.worker.creaseEdges()
+        : await this.worker.sharpEdges(settings.degrees, settings.minEdges, settings.closedOnly);
       if (this.open !== mesh) return;
-      const n = (k: number, one: string, many: string) => `${k} ${k === 1 ? one : many}`;
-      const pruned = stats.pruned_edges ? `, ${n(stats.pruned_edges, 'dangling edge', 'dangling edges')}` : '';
-      this.el.sharpStats.textContent = `${n(stats.sharp_edges, 'sharp edge', 'sharp edges')}: ${n(stats.curves, 'curve', 'curves')} (${n(stats.kept_edges, 'edge', 'edges')}) kept, ${n(stats.dropped_fragments, 'fragment', 'fragments')}${pruned} dropped`;
-      this.changed(f.setSharp(edges, settings, drag));
+      this.showStats(settings, found);
+      this.changed(f.setSharp(found.edges, settings, drag));
     } catch (e) {
       if (!(e instanceof Cancelled)) this.events.onError(`sharp edges: ${e instanceof Error ? e.message : String(e)}`);
     }
+  }
+
+  /**
+   * Marks the creases `conemap quads` follows by default instead of the
+   * last detection's edges (one undo step; edges marked by hand stay), and
+   * shows the preset's settings in the controls.
+   */
+  private requestCreases(): void {
+    this.sharpQueue = this.sharpQueue.then(async () => {
+      const mesh = this.open;
+      const f = mesh?.features;
+      if (!f) return;
+      try {
+        const found = await this.worker.creaseEdges();
+        if (this.open !== mesh) return;
+        const settings: SharpSettings = { degrees: found.degrees, minEdges: 0, closedOnly: false, creases: true };
+        this.showSharpSettings(settings);
+        this.showStats(settings, found);
+        this.changed(f.setSharp(found.edges, settings));
+      } catch (e) {
+        if (!(e instanceof Cancelled)) this.events.onError(`creases: ${e instanceof Error ? e.message : String(e)}`);
+      }
+    });
   }
 
   /** Reads a features file or JSON report and marks the edges it names instead of the current ones (one undo step). */
@@ -292,6 +336,7 @@ export class FeatureEditor {
     el.sharpAngle.addEventListener('change', () => this.requestSharp(true, true));
     el.sharpMinEdges.addEventListener('change', () => this.requestSharp(false));
     el.sharpClosed.addEventListener('change', () => this.requestSharp(false));
+    el.creases.addEventListener('click', () => this.requestCreases());
     el.undo.addEventListener('click', () => this.stepped(this.open?.features?.undo() ?? false));
     el.redo.addEventListener('click', () => this.stepped(this.open?.features?.redo() ?? false));
     el.clear.addEventListener('click', () => {

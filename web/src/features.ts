@@ -7,6 +7,8 @@ export interface SharpSettings {
   degrees: number;
   minEdges: number;
   closedOnly: boolean;
+  /** The creases preset (`MeshSession.crease_edges`; `degrees` is its threshold): the quads may drop these edges. */
+  creases?: true;
 }
 
 /** One undoable change: the edges flipped, the sharp edges and settings before and after; `open` while a slider drag may extend it. */
@@ -168,6 +170,14 @@ export class FeatureSet {
     this.settings = change.settingsAfter;
     this.undoStack.push(change);
     return true;
+  }
+
+  /** Marked edge ids found by the creases preset (still marked and the preset in use), ascending. */
+  creaseIds(): Uint32Array {
+    if (!this.settings?.creases) return new Uint32Array(0);
+    const out: number[] = [];
+    for (let e = 0; e < this.edgeCount; e++) if (this.sharp[e] && this.flags[e]) out.push(e);
+    return Uint32Array.from(out);
   }
 
   /** Marked edge ids, ascending. */

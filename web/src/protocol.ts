@@ -20,11 +20,14 @@ export type Request =
       simulateTrap?: boolean;
     }
   | { id: number; type: 'sharp'; degrees: number; minEdges: number; closedOnly: boolean }
+  /** The creases `conemap quads` follows where no features are given; answers a `CreaseResult`. */
+  | { id: number; type: 'creases' }
   /** Edge ids of the open mesh named by a features file or JSON report (`text`); answers a `Uint32Array`. */
   | { id: number; type: 'features-from-json'; text: string }
   // A solve in steps (so that a helper worker can place some components):
   // begin → place every component (here, or in a helper and then add) → finish.
-  | { id: number; type: 'solve-begin'; features: Uint32Array; alphaSmooth: number; miq: boolean; freeBoundary?: boolean; maxConeRefinements?: number | undefined }
+  /** `creases`: those of `features` found by `creases` rather than marked (the quads drop them where they fold the map). */
+  | { id: number; type: 'solve-begin'; features: Uint32Array; creases?: Uint32Array; alphaSmooth: number; miq: boolean; freeBoundary?: boolean; maxConeRefinements?: number | undefined }
   /** Places one component; with `share` the result answers `{ bytes }` for `solve-add` elsewhere. */
   | { id: number; type: 'solve-place'; component: number; share: boolean }
   | { id: number; type: 'solve-add'; bytes: Uint8Array }
@@ -336,6 +339,8 @@ export interface QuadsResult {
   cancelled_pairs: number;
   /** Input feature edges the map was solved without: the map with them folded and the grid is too coarse to follow them (0: every feature kept). */
   dropped_feature_edges: number;
+  /** Of those, the edges marked as creases (the map with them folded on their part of the mesh). */
+  dropped_crease_edges: number;
   /** The mesh the map was solved on: its faces and the vertices inserted into the input (a low-poly mesh is refined for quads). */
   solved_faces: number;
   inserted_vertices: number;
@@ -363,7 +368,7 @@ export const QUAD_REPORT_KEYS = {
 } as const satisfies Keys<QuadReport>;
 export const QUADS_RESULT_KEYS = {
   quantization: true, report: true, uv: true, positions: true, quads: true, edges: true, singular: true, defects: true,
-  cones: true, cancelled_pairs: true, dropped_feature_edges: true, solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
+  cones: true, cancelled_pairs: true, dropped_feature_edges: true, dropped_crease_edges: true, solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
 } as const satisfies Keys<QuadsResult>;
 
 /** A solve as the page receives it: the wasm result and what the worker adds. */
@@ -403,6 +408,13 @@ export interface SharpResult {
   edges: Uint32Array;
   /** Counts of the detection (`features::SharpStats`). */
   stats: { sharp_edges: number; curves: number; kept_edges: number; dropped_fragments: number; pruned_edges: number };
+}
+
+/** The creases of `MeshSession.crease_edges` (crate `features::CREASES`): a detection and its settings. */
+export interface CreaseResult extends SharpResult {
+  /** Dihedral threshold, and the shortest curve kept as a fraction of the bounding-box diagonal. */
+  degrees: number;
+  min_length_fraction: number;
 }
 
 /**

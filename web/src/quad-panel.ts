@@ -293,8 +293,13 @@ function quadTable(s: Shown, counts: ReturnType<typeof valenceCounts>): HTMLDLis
       : fmtInt(s.result.cones)],
   ];
   if (boundarySingular > 0) rows.push(['Irregular boundary vertices', fmtInt(boundarySingular)]);
-  if (s.result.dropped_feature_edges > 0) {
-    rows.push(['Features not followed', `${fmtInt(s.result.dropped_feature_edges)} edges (short branches and small loops the quads are too large for; the map with them folded)`]);
+  const creases = s.result.dropped_crease_edges;
+  const marked = s.result.dropped_feature_edges - creases;
+  if (marked > 0) {
+    rows.push(['Features not followed', `${fmtInt(marked)} edges (short branches and small loops the quads are too large for; the map with them folded)`]);
+  }
+  if (creases > 0) {
+    rows.push(['Creases not followed', `${fmtInt(creases)} edges (the map with them folded on their part of the mesh)`]);
   }
   rows.push(
     ['Corner angle deviation (mean / max)', `${fmt(r.angle_mean_deviation, 1)}° / ${fmt(r.angle_max_deviation, 1)}°`],
@@ -330,6 +335,12 @@ function quadsHook(s: Shown, counts: ReturnType<typeof valenceCounts>, gridCheck
     distortionBefore: r.quantization.distortion_before,
     distortionAfter: r.quantization.distortion_after,
     defects: r.defects,
+    distance: r.report.distance_quads_to_input_relative === undefined || r.report.distance_input_to_quads_relative === undefined
+      ? null
+      : Math.max(r.report.distance_quads_to_input_relative, r.report.distance_input_to_quads_relative),
+    sharpWithin: r.report.fraction_sharp_within_tolerance ?? null,
+    droppedFeatures: s.result.dropped_feature_edges,
+    droppedCreases: s.result.dropped_crease_edges,
     solvedFaces: r.solved_faces,
     insertedVertices: r.inserted_vertices,
     uvCorners: r.uv.length / 2,

@@ -170,7 +170,7 @@ export class SolveController {
     const t0 = performance.now();
     let outcome: Outcome;
     try {
-      const result = await this.worker.solve(features, alpha, miq, (stage, step, remaining, fraction) => {
+      const result = await this.worker.solve(features, m.features?.creaseIds() ?? new Uint32Array(0), alpha, miq, (stage, step, remaining, fraction) => {
         if (this.active === run) this.setProgress(stage, step, remaining, fraction);
       }, freeBoundary, this.store.state.tuning);
       if (this.active !== run) return;

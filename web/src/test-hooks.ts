@@ -58,6 +58,13 @@ export interface QuadsHook {
   distortionBefore: number;
   distortionAfter: number;
   defects: number;
+  /** Two-sided distance between the quads and the input (fraction of the diagonal, the larger side; null: not measured). */
+  distance: number | null;
+  /** Share of the sharp input edges' points near a quad edge (null: no sharp edge checked). */
+  sharpWithin: number | null;
+  /** Feature edges the map was solved without, and how many of them were marked as creases. */
+  droppedFeatures: number;
+  droppedCreases: number;
   /** Faces of the mesh the map was solved on, and the vertices inserted into the input for it. */
   solvedFaces: number;
   insertedVertices: number;

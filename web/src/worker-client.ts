@@ -8,7 +8,7 @@
 // worker opens the same mesh and places some of the cut mesh's components
 // (they are independent), which halves the cone stage on two cores. Quads are
 // asked of the worker that finished the solve (its session keeps the map).
-import type { ErrorLocation, ImportResult, QuadsResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
+import type { CreaseResult, ErrorLocation, ImportResult, QuadsResult, Request, Response, SharpResult, SolveBegun, SolveResult, Stage, WireFile } from './protocol';
 import type { SolveTuning } from './state';
 
 export class WorkerCrashed extends Error {
@@ -177,6 +177,11 @@ export class MeshWorker {
     return this.send<SharpResult>({ type: 'sharp', degrees, minEdges, closedOnly });
   }
 
+  /** The creases `conemap quads` follows by default on the open mesh, with the detection's counts and settings. */
+  creaseEdges(): Promise<CreaseResult> {
+    return this.send<CreaseResult>({ type: 'creases' });
+  }
+
   /** Edge ids of the open mesh that a features file or JSON report (`text`) names by position; rejects saying what does not match. */
   featuresFromJson(text: string): Promise<Uint32Array> {
     return this.send<Uint32Array>({ type: 'features-from-json', text });
@@ -187,15 +192,17 @@ export class MeshWorker {
    * (some in a helper worker on large meshes), finish. Progress comes from this
    * worker (and from the helper once this one has nothing left to place).
    * `tuning` says when a helper is used and how hard the cone placement tries.
+   * `creases`: those of `features` that the creases preset found (see
+   * `creaseEdges`): the quads drop them where they fold the map.
    */
-  async solve(features: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn, freeBoundary: boolean, tuning: Readonly<SolveTuning>): Promise<SolveResult> {
+  async solve(features: Uint32Array, creases: Uint32Array, alphaSmooth: number, miq: boolean, onProgress: ProgressFn, freeBoundary: boolean, tuning: Readonly<SolveTuning>): Promise<SolveResult> {
     const generation = this.restarts;
     this.solvedIn = null; // a solve begun drops the session's last map, whatever its outcome
     /** Throws `Cancelled` once this worker was replaced (cancel or crash) since the solve began. */
     const alive = (): void => {
       if (this.restarts !== generation) throw new Cancelled('cancelled');
     };
-    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, alphaSmooth, miq, freeBoundary, maxConeRefinements: tuning.maxConeRefinements }, [], onProgress);
+    const { schedule } = await this.send<SolveBegun>({ type: 'solve-begin', features, creases, alphaSmooth, miq, freeBoundary, maxConeRefinements: tuning.maxConeRefinements }, [], onProgress);
     const queue = Array.from(schedule);
     const total = schedule.length;
     const helper = this.startHelper(features, alphaSmooth, miq, freeBoundary, schedule, tuning.helperMinFaces);

@@ -4,7 +4,7 @@
 // solves do not re-import it, and quads re-use the session's last solve.
 import init, { MeshSession, default_alpha, version } from '@conemap/wasm';
 import { MAX_WIREFRAME_FACES, uniqueEdges } from './edges';
-import type { ErrorLocation, ImportResult, MeshReport, QuadsResult, Request, Response, SharpResult, SolveResult, SolveView, WasmSolveResult } from './protocol';
+import type { CreaseResult, ErrorLocation, ImportResult, MeshReport, QuadsResult, Request, Response, SharpResult, SolveResult, SolveView, WasmSolveResult } from './protocol';
 import { buildSolveView, viewBuffers } from './solve-view';
 import { buildAdjacency, faceEdges } from './topology';
 
@@ -30,9 +30,10 @@ interface Session {
   boundary_edges(): Uint32Array;
   sharp_edges(degrees: number): Uint32Array;
   sharp_curves(degrees: number, minEdges: number, closedOnly: boolean): SharpResult;
+  crease_edges(): CreaseResult;
   features_from_json(text: string): Uint32Array;
   /** `alpha` undefined: the library's default for `miq` (`default_alpha`). */
-  solve_begin(features: Uint32Array, alpha: number | undefined, miq: boolean): Uint32Array;
+  solve_begin(features: Uint32Array, alpha: number | undefined, miq: boolean, creases: Uint32Array | undefined): Uint32Array;
   set_max_cone_refinements(n: number | undefined): void;
   set_free_boundary(free: boolean): void;
   solve_place(component: number, share: boolean, progress: Progress): Uint8Array | undefined;
@@ -143,7 +144,7 @@ function solveStep(req: Extract<Request, { type: 'solve-begin' | 'solve-place' |
       stepsStart = performance.now();
       s.set_max_cone_refinements(req.maxConeRefinements);
       s.set_free_boundary(req.freeBoundary ?? false);
-      const schedule = s.solve_begin(req.features, req.alphaSmooth, req.miq);
+      const schedule = s.solve_begin(req.features, req.alphaSmooth, req.miq, req.creases);
       return { value: { schedule }, transfer: [schedule.buffer] };
     }
     case 'solve-place': {
@@ -217,6 +218,11 @@ async function handle(req: Request): Promise<void> {
         break;
       case 'sharp': {
         const found = requireSession().sharp_curves(req.degrees, req.minEdges, req.closedOnly);
+        out = { value: found, transfer: [found.edges.buffer] };
+        break;
+      }
+      case 'creases': {
+        const found = requireSession().crease_edges();
         out = { value: found, transfer: [found.edges.buffer] };
         break;
       }

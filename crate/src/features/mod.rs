@@ -110,6 +110,11 @@ impl FeatureSet {
         FeatureSet { is_feature: self.is_feature.iter().zip(&other.is_feature).map(|(&a, &b)| a && !b).collect() }
     }
 
+    /// The features also in `other` (same mesh).
+    pub fn intersection(&self, other: &FeatureSet) -> FeatureSet {
+        FeatureSet { is_feature: self.is_feature.iter().zip(&other.is_feature).map(|(&a, &b)| a && b).collect() }
+    }
+
     /// True when edge `e` is a feature.
     pub fn contains(&self, e: u32) -> bool {
         self.is_feature[e as usize]

@@ -62,6 +62,13 @@ impl GridFeatures {
     pub fn detected(creases: FeatureSet) -> GridFeatures {
         GridFeatures { all: creases.clone(), detected: creases }
     }
+
+    /// Features `all`, of which those also in `creases` were found for the
+    /// caller (the page's "Creases" button) and are droppable.
+    pub fn with_creases(all: FeatureSet, creases: &FeatureSet) -> GridFeatures {
+        let detected = all.intersection(creases);
+        GridFeatures { all, detected }
+    }
 }
 
 /// A solved map kept for integer-grid maps of any size, with the maps
@@ -136,6 +143,12 @@ impl GridStage {
     /// The features solved for (every one, the dropped ones too).
     pub fn features(&self) -> &FeatureSet {
         &self.features.all
+    }
+
+    /// Those of [`GridStage::features`] found rather than asked for
+    /// ([`GridFeatures::detected`]).
+    pub fn detected_features(&self) -> &FeatureSet {
+        &self.features.detected
     }
 
     /// The integer-grid map for `size` of the stage's map, solved on `input`
