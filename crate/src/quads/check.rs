@@ -361,7 +361,7 @@ pub(crate) fn newell_normal(p: &[V3; 4]) -> V3 {
 /// True for a quad (indices in range) with a repeated vertex, an area below
 /// `1e-12` of its squared perimeter scale, or folded along both diagonals
 /// (the two triangles of either split face opposite ways: a bow-tie).
-fn is_degenerate(quads: &QuadMesh, q: usize) -> bool {
+pub(crate) fn is_degenerate(quads: &QuadMesh, q: usize) -> bool {
     if has_repeated_vertex(&quads.quads[q]) {
         return true;
     }
@@ -426,25 +426,26 @@ fn corner_angles(quads: &QuadMesh, valid: &[bool]) -> AngleStats {
 /// flipped that way).
 fn flipped_quads(input: &TriMesh, quads: &QuadMesh, valid: &[bool]) -> usize {
     let normals = input.face_normals();
+    (0..quads.n_quads()).filter(|&q| valid[q] && is_flipped(input, normals, quads, q)).count()
+}
+
+/// True when quad `q` (indices in range) faces against the input as
+/// [`flipped_quads`] counts it (`normals`: the input's face normals).
+pub(crate) fn is_flipped(input: &TriMesh, normals: &[V3], quads: &QuadMesh, q: usize) -> bool {
     let triangle = |f: u32| input.faces()[f as usize].map(|v| input.position(v));
-    (0..quads.n_quads())
-        .filter(|&q| valid[q])
-        .filter(|&q| {
-            let points = quad_points(quads, q);
-            let centre = scale(add(add(points[0], points[1]), add(points[2], points[3])), 0.25);
-            let reference = quads.quads[q]
-                .iter()
-                .filter_map(|&v| quads.locations.get(v as usize))
-                .filter(|l| (l.face as usize) < normals.len())
-                .map(|l| {
-                    let distance = |f: &u32| point_triangle_distance(centre, &triangle(*f));
-                    let nearest = faces_at(input, l).into_iter().min_by(|a, b| distance(a).total_cmp(&distance(b)));
-                    normals[nearest.unwrap_or(l.face) as usize]
-                })
-                .fold([0.0; 3], add);
-            dot(newell_normal(&points), reference) < 0.0
+    let points = quad_points(quads, q);
+    let centre = scale(add(add(points[0], points[1]), add(points[2], points[3])), 0.25);
+    let reference = quads.quads[q]
+        .iter()
+        .filter_map(|&v| quads.locations.get(v as usize))
+        .filter(|l| (l.face as usize) < normals.len())
+        .map(|l| {
+            let distance = |f: &u32| point_triangle_distance(centre, &triangle(*f));
+            let nearest = faces_at(input, l).into_iter().min_by(|a, b| distance(a).total_cmp(&distance(b)));
+            normals[nearest.unwrap_or(l.face) as usize]
         })
-        .count()
+        .fold([0.0; 3], add);
+    dot(newell_normal(&points), reference) < 0.0
 }
 
 /// Barycentric coordinate below which a surface point lies on the edge

@@ -13,7 +13,10 @@
 //! 6. `fill::fill_holes`: the holes left where cells were skipped (flipped
 //!    triangles) are filled with quads on the input surface;
 //! 7. `corners::align_curve_corners`: quad vertices slid along feature and
-//!    boundary polylines onto the corners quad edges would cut.
+//!    boundary polylines onto the corners quad edges would cut;
+//! 8. `untangle::untangle`: quad vertices off the curves moved along the
+//!    surface where their quads fold in 3D (a cell over a tip tighter than
+//!    itself), unless that takes the quads further from the input.
 //!
 //! Every predicate after step 1 is exact integer arithmetic. Where the map is
 //! not a valid integer-grid map the extractor closes or skips what it cannot
@@ -24,6 +27,7 @@ mod faces;
 mod fill;
 mod snap;
 mod trace;
+mod untangle;
 mod vertices;
 
 #[cfg(test)]
@@ -52,11 +56,13 @@ pub struct ExtractOptions {
     pub max_trace_steps: usize,
     /// At most this many quad vertices are enumerated (a defect beyond).
     pub max_vertices: usize,
+    /// Step 8: move the vertices of quads that fold in 3D along the surface.
+    pub untangle: bool,
 }
 
 impl Default for ExtractOptions {
     fn default() -> Self {
-        ExtractOptions { snap_tolerance: 1e-6, max_trace_steps: 1_000, max_vertices: 10_000_000 }
+        ExtractOptions { snap_tolerance: 1e-6, max_trace_steps: 1_000, max_vertices: 10_000_000, untangle: true }
     }
 }
 
@@ -159,6 +165,9 @@ pub fn extract_quads_along(mesh: &TriMesh, features: &FeatureSet, uv: &[[f64; 2]
     drop_pillows(&mut quads);
     drop_unreferenced(&mut quads);
     corners::align_curve_corners(mesh, features, &mut quads);
+    if options.untangle {
+        untangle::untangle(mesh, features, &mut quads);
+    }
     Ok(quads)
 }
 

@@ -17,6 +17,8 @@ pub mod extract;
 pub use check::{check_quads, CheckOptions, QuadReport};
 pub use extract::{exact_grid_uv, extract_quads, extract_quads_along, ExtractError, ExtractOptions};
 
+use crate::mesh::TriMesh;
+use crate::vec3::{barycentric_point, closest_point_barycentric, norm, sub, V3};
 use serde::Serialize;
 
 /// A quad mesh traced on a triangle mesh.
@@ -44,6 +46,24 @@ pub struct QuadMesh {
 pub struct SurfacePoint {
     pub face: u32,
     pub bary: [f64; 3],
+}
+
+impl SurfacePoint {
+    /// The point of `faces` (of `mesh`) nearest to `x`, and its position;
+    /// `x` itself in face 0 when `faces` is empty.
+    pub fn nearest(mesh: &TriMesh, faces: impl IntoIterator<Item = u32>, x: V3) -> (SurfacePoint, V3) {
+        let mut best = (f64::INFINITY, SurfacePoint { face: 0, bary: [1.0, 0.0, 0.0] }, x);
+        for f in faces {
+            let t = mesh.faces()[f as usize].map(|v| mesh.position(v));
+            let bary = closest_point_barycentric(x, &t);
+            let p = barycentric_point(&t, bary);
+            let d = norm(sub(p, x));
+            if d < best.0 {
+                best = (d, SurfacePoint { face: f, bary }, p);
+            }
+        }
+        (best.1, best.2)
+    }
 }
 
 /// A place where the map is not a valid integer-grid map and what the

@@ -5,7 +5,7 @@
 
 use crate::mesh::NONE;
 use crate::quads::{QuadMesh, SurfacePoint};
-use crate::vec3::{add, barycentric_point, closest_point_barycentric, cross, dot, norm, scale, sub, V3};
+use crate::vec3::{add, cross, dot, norm, scale, sub, V3};
 use crate::TriMesh;
 use std::collections::HashMap;
 
@@ -109,17 +109,7 @@ impl Patch<'_> {
 
     /// The point of the searched input faces nearest to `x`.
     fn nearest(&self, x: V3) -> (SurfacePoint, V3) {
-        let mut best = (f64::INFINITY, SurfacePoint { face: 0, bary: [1.0, 0.0, 0.0] }, x);
-        for &f in &self.faces {
-            let t = self.mesh.faces()[f as usize].map(|v| self.mesh.position(v));
-            let bary = closest_point_barycentric(x, &t);
-            let p = barycentric_point(&t, bary);
-            let d = norm(sub(p, x));
-            if d < best.0 {
-                best = (d, SurfacePoint { face: f, bary }, p);
-            }
-        }
-        (best.1, best.2)
+        SurfacePoint::nearest(self.mesh, self.faces.iter().copied(), x)
     }
 
     /// A new quad vertex at the point of the input nearest to `x`.
