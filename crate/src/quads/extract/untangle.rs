@@ -143,11 +143,15 @@ fn move_vertices(mesh: &TriMesh, features: &FeatureSet, quads: &mut QuadMesh, fa
             i >= 3 && n == i && !on_curve(mesh, features, &quads.locations[v as usize])
         })
         .collect();
+    // The quads the moves can change.
+    let mut touched: Vec<usize> = region.iter().flat_map(|&v| incident[v as usize].iter().map(|&q| q as usize)).collect();
+    touched.sort_unstable();
+    touched.dedup();
     let mut moves = 0;
     for _ in 0..ROUNDS {
         let mut candidates: Vec<u32> = Vec::new();
         let mut seen = HashSet::new();
-        for q in (0..quads.n_quads()).filter(|&q| folds(quads, q)) {
+        for q in touched.iter().copied().filter(|&q| folds(quads, q)) {
             for &v in &quads.quads[q] {
                 for w in std::iter::once(v).chain(neighbours[v as usize].iter().copied()) {
                     if seen.insert(w) && movable.contains(&w) {
