@@ -47,6 +47,9 @@ const SINGULAR_REACH: f64 = 0.3;
 /// and flipped quads.
 const MIN_GAIN: f64 = 1e-3;
 
+/// At most this many groups of places are judged (a distance check each).
+const MAX_JUDGED: usize = 8;
+
 /// Input faces searched for the point nearest to a moved vertex, at most.
 const MAX_SEARCH_FACES: usize = 4_096;
 
@@ -70,10 +73,17 @@ pub(super) fn untangle(mesh: &TriMesh, features: &FeatureSet, quads: &mut QuadMe
     let slack = 1e-9 * mesh.bounding_diagonal();
     let mut before = distances(quads);
     let mut moves = 0;
-    // Each place (folded quads joined by their vertices) on its own: its
-    // moves are undone where they take the quads further from the input.
-    for place in places(quads, &folded) {
-        let region: HashSet<u32> = place.iter().flat_map(|&q| quads.quads[q]).flat_map(|v| std::iter::once(v).chain(fans.neighbours[v as usize].iter().copied())).collect();
+    // Each place (folded quads joined by their vertices) on its own, or a
+    // few together where there are many: their moves are undone where they
+    // take the quads further from the input.
+    let places = places(quads, &folded);
+    for group in places.chunks(places.len().div_ceil(MAX_JUDGED)) {
+        let region: HashSet<u32> = group
+            .iter()
+            .flatten()
+            .flat_map(|&q| quads.quads[q])
+            .flat_map(|v| std::iter::once(v).chain(fans.neighbours[v as usize].iter().copied()))
+            .collect();
         let kept = (quads.positions.clone(), quads.locations.clone());
         let moved = move_vertices(mesh, features, quads, &fans, &region);
         let after = distances(quads);
