@@ -1,9 +1,9 @@
 // Feature editing on the open mesh: the edge under the pointer highlighted and
 // a click toggling it, Shift-click two vertices to mark the shortest path
 // between them, the sharp-edge detection controls (a slider drag is one undo
-// step) and the creases preset, undo / redo / clear (buttons and keys, the detection settings with
-// the edges), features import and export as JSON; and the queries of the
-// open mesh's geometry the test hooks answer with.
+// step) and the creases preset, undo / redo / clear (buttons and keys, the
+// detection settings with the edges), features import and export as JSON;
+// and the queries of the open mesh's geometry the test hooks answer with.
 import { $, fmtInt } from './dom';
 import { download, fileStem } from './downloads';
 import { FeatureSet, type SharpSettings } from './features';
