@@ -251,8 +251,7 @@ export class FeatureEditor {
 
   /** Runs the detection the controls ask for on the open mesh and marks its edges (see `requestSharp`). */
   private async applySharp(drag: boolean): Promise<void> {
-    const mesh = this.open;
-    const f = mesh?.features;
+    const f = this.open?.features;
     if (!f) return;
     const settings = this.controlSettings();
     if (JSON.stringify(settings) === JSON.stringify(f.sharpSettings)) return;
@@ -261,16 +260,7 @@ export class FeatureEditor {
       this.changed(f.setSharp(null, null));
       return;
     }
-    try {
-      const found = settings.creases
-        ? await this.worker.creaseEdges()
-        : await this.worker.sharpEdges(settings.degrees, settings.minEdges, settings.closedOnly);
-      if (this.open !== mesh) return;
-      this.showStats(settings, found);
-      this.changed(f.setSharp(found.edges, settings, drag));
-    } catch (e) {
-      if (!(e instanceof Cancelled)) this.events.onError(`sharp edges: ${e instanceof Error ? e.message : String(e)}`);
-    }
+    await this.detect(settings, drag);
   }
 
   /**
@@ -279,21 +269,36 @@ export class FeatureEditor {
    * shows the preset's settings in the controls.
    */
   private requestCreases(): void {
-    this.sharpQueue = this.sharpQueue.then(async () => {
-      const mesh = this.open;
-      const f = mesh?.features;
-      if (!f) return;
-      try {
-        const found = await this.worker.creaseEdges();
-        if (this.open !== mesh) return;
-        const settings: SharpSettings = { degrees: found.degrees, minEdges: 0, closedOnly: false, creases: true };
-        this.showSharpSettings(settings);
-        this.showStats(settings, found);
-        this.changed(f.setSharp(found.edges, settings));
-      } catch (e) {
-        if (!(e instanceof Cancelled)) this.events.onError(`creases: ${e instanceof Error ? e.message : String(e)}`);
+    this.sharpQueue = this.sharpQueue.then(() => this.detect('creases', false));
+  }
+
+  /**
+   * Runs a detection on the open mesh and marks its edges in place of the
+   * last detection's (`drag`: part of a slider drag): with `wanted`, or the
+   * creases preset, whose settings come with its answer and are shown in
+   * the controls.
+   */
+  private async detect(wanted: SharpSettings | 'creases', drag: boolean): Promise<void> {
+    const mesh = this.open;
+    const f = mesh?.features;
+    if (!f) return;
+    try {
+      let found: SharpResult | CreaseResult;
+      let settings: SharpSettings;
+      if (wanted === 'creases' || wanted.creases) {
+        const creases = await this.worker.creaseEdges();
+        [found, settings] = [creases, { degrees: creases.degrees, minEdges: 0, closedOnly: false, creases: true }];
+      } else {
+        [found, settings] = [await this.worker.sharpEdges(wanted.degrees, wanted.minEdges, wanted.closedOnly), wanted];
       }
-    });
+      if (this.open !== mesh) return;
+      if (settings.creases) this.showSharpSettings(settings);
+      this.showStats(settings, found);
+      this.changed(f.setSharp(found.edges, settings, drag));
+    } catch (e) {
+      const what = wanted === 'creases' ? 'creases' : 'sharp edges';
+      if (!(e instanceof Cancelled)) this.events.onError(`${what}: ${e instanceof Error ? e.message : String(e)}`);
+    }
   }
 
   /** Reads a features file or JSON report and marks the edges it names instead of the current ones (one undo step). */

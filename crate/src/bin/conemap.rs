@@ -447,7 +447,6 @@ fn grid_features(args: &Args, mesh: &TriMesh) -> Result<GridFeatures, Failure> {
     Ok(GridFeatures::detected(creases))
 }
 
-
 /// Both stages' settings: [`cone_options`] and `--max-edge L|X%` (split
 /// edges longer than L model units, or X % of `mesh`'s bounding-box
 /// diagonal, before the cones); `default_max_edge` when the flag is absent.

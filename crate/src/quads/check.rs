@@ -14,7 +14,7 @@
 //! ([`box_grid`]), so the cost is about linear in the number of samples and
 //! primitives.
 
-use super::{QuadMesh, SurfacePoint};
+use super::{OnFace, QuadMesh, SurfacePoint};
 use box_grid::{BoxGrid, Visited};
 use crate::mesh::UnionFind;
 use crate::vec3::{add, angle, bounds, cross, dot, midpoint, norm, point_segment_distance, point_triangle_distance, scale, sub, V3};
@@ -448,23 +448,13 @@ pub(crate) fn is_flipped(input: &TriMesh, normals: &[V3], quads: &QuadMesh, q: u
     dot(newell_normal(&points), reference) < 0.0
 }
 
-/// Barycentric coordinate below which a surface point lies on the edge
-/// opposite that corner.
-const ON_EDGE: f64 = 1e-9;
-
 /// The input faces that hold surface point `l`: its face, and where it lies
 /// on an edge or at a vertex of it, the faces around that edge or vertex.
 fn faces_at(input: &TriMesh, l: &SurfacePoint) -> Vec<u32> {
-    let off: Vec<usize> = (0..3).filter(|&i| l.bary[i] < ON_EDGE).collect();
-    match off.as_slice() {
-        // At the corner whose coordinate is not ~0.
-        [a, b] => input.vertex_faces(input.faces()[l.face as usize][3 - a - b]).collect(),
-        // On the edge opposite corner `a`: face halfedge `a + 1` (corner `a + 1` → `a + 2`).
-        [a] => {
-            let h = input.face_halfedges(l.face)[(a + 1) % 3];
-            [input.face(h), input.face(input.twin(h))].into_iter().flatten().collect()
-        }
-        _ => vec![l.face],
+    match l.on_face(input) {
+        OnFace::Corner(v) => input.vertex_faces(v).collect(),
+        OnFace::Side(h) => [input.face(h), input.face(input.twin(h))].into_iter().flatten().collect(),
+        OnFace::Inside => vec![l.face],
     }
 }
 

@@ -48,7 +48,35 @@ pub struct SurfacePoint {
     pub bary: [f64; 3],
 }
 
+/// Barycentric coordinate below which a surface point lies on the edge
+/// opposite that corner.
+const ON_EDGE: f64 = 1e-9;
+
+/// Where a [`SurfacePoint`] lies on its input face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OnFace {
+    /// Inside the face.
+    Inside,
+    /// On the face's side `h` (a halfedge of the face).
+    Side(u32),
+    /// At the face's corner vertex `v`.
+    Corner(u32),
+}
+
 impl SurfacePoint {
+    /// Where the point lies on its face: at a corner where two barycentric
+    /// coordinates are below `1e-9`, on a side where one is.
+    pub fn on_face(&self, mesh: &TriMesh) -> OnFace {
+        let off: Vec<usize> = (0..3).filter(|&i| self.bary[i] < ON_EDGE).collect();
+        match off.as_slice() {
+            // At the corner whose coordinate is not ~0.
+            [a, b] => OnFace::Corner(mesh.faces()[self.face as usize][3 - a - b]),
+            // On the side opposite corner `a`: face halfedge `a + 1` (corner `a + 1` → `a + 2`).
+            [a] => OnFace::Side(mesh.face_halfedges(self.face)[(a + 1) % 3]),
+            _ => OnFace::Inside,
+        }
+    }
+
     /// The point of `faces` (of `mesh`) nearest to `x`, and its position;
     /// `x` itself in face 0 when `faces` is empty.
     pub fn nearest(mesh: &TriMesh, faces: impl IntoIterator<Item = u32>, x: V3) -> (SurfacePoint, V3) {
@@ -92,6 +120,17 @@ impl QuadMesh {
         }
         self.quads.truncate(kept);
         self.uv.truncate(4 * kept);
+    }
+
+    /// The quads at each vertex (a quad twice where it repeats the vertex).
+    pub(crate) fn vertex_quads(&self) -> Vec<Vec<u32>> {
+        let mut out = vec![Vec::new(); self.positions.len()];
+        for (q, corners) in self.quads.iter().enumerate() {
+            for &v in corners {
+                out[v as usize].push(q as u32);
+            }
+        }
+        out
     }
 
     pub fn n_vertices(&self) -> usize {

@@ -79,7 +79,7 @@ pub(super) fn align_curve_corners(mesh: &TriMesh, features: &FeatureSet, quads: 
             _ => {}
         }
     }
-    let incident = vertex_quads(quads);
+    let incident = quads.vertex_quads();
     // Corners of the polylines, sharpest first.
     let mut corners: Vec<(f64, u32, [u32; 2])> = (0..mesh.n_vertices() as u32)
         .filter(|&c| !at_vertex[c as usize])
@@ -184,17 +184,6 @@ fn polyline_to(mesh: &TriMesh, curve: &dyn Fn(u32) -> bool, c: u32, first: u32, 
         (from, e) = (x, next);
     }
     None
-}
-
-/// The quads around each quad vertex.
-fn vertex_quads(quads: &QuadMesh) -> Vec<Vec<u32>> {
-    let mut out = vec![Vec::new(); quads.positions.len()];
-    for (q, corners) in quads.quads.iter().enumerate() {
-        for &v in corners {
-            out[v as usize].push(q as u32);
-        }
-    }
-    out
 }
 
 /// True when moving quad vertex `v` to `to` leaves every quad of `around`

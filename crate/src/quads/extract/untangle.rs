@@ -30,7 +30,7 @@ use super::QuadMesh;
 use crate::features::FeatureSet;
 use crate::mesh::{TriMesh, UnionFind};
 use crate::quads::check::{check_quads, is_degenerate, is_flipped, CheckOptions};
-use crate::quads::SurfacePoint;
+use crate::quads::{OnFace, SurfacePoint};
 use crate::vec3::{add, cross, dot, norm, point_triangle_distance, scale, sub, V3};
 use std::collections::HashSet;
 
@@ -52,9 +52,6 @@ const MAX_JUDGED: usize = 8;
 
 /// Input faces searched for the point nearest to a moved vertex, at most.
 const MAX_SEARCH_FACES: usize = 4_096;
-
-/// Barycentric coordinate below which a surface point lies on an edge.
-const ON_EDGE: f64 = 1e-9;
 
 /// Moves the vertices of the quads that fold in 3D along the input surface
 /// until fewer fold (see the module doc); returns how many moves were kept.
@@ -105,13 +102,10 @@ struct Fans {
 
 impl Fans {
     fn new(quads: &QuadMesh) -> Fans {
-        let n = quads.n_vertices();
-        let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
-        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for (q, quad) in quads.quads.iter().enumerate() {
+        let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); quads.n_vertices()];
+        for quad in &quads.quads {
             for i in 0..4 {
                 let (a, b) = (quad[i], quad[(i + 1) % 4]);
-                incident[a as usize].push(q as u32);
                 for (x, y) in [(a, b), (b, a)] {
                     if !neighbours[x as usize].contains(&y) {
                         neighbours[x as usize].push(y);
@@ -119,7 +113,7 @@ impl Fans {
                 }
             }
         }
-        Fans { incident, neighbours }
+        Fans { incident: quads.vertex_quads(), neighbours }
     }
 }
 
@@ -186,8 +180,8 @@ fn move_vertices(mesh: &TriMesh, features: &FeatureSet, quads: &mut QuadMesh, fa
             let (old_position, old_location) = (quads.positions[v as usize], quads.locations[v as usize]);
             let nb = &neighbours[v as usize];
             let mean = scale(nb.iter().fold([0.0; 3], |s, &w| add(s, quads.positions[w as usize])), 1.0 / nb.len() as f64);
-            let reach = nb.iter().map(|&w| norm(sub(quads.positions[w as usize], old_position))).fold(0.0, f64::max);
-            let shortest = nb.iter().map(|&w| norm(sub(quads.positions[w as usize], old_position))).fold(f64::INFINITY, f64::min);
+            let lengths = nb.iter().map(|&w| norm(sub(quads.positions[w as usize], old_position)));
+            let (reach, shortest) = (lengths.clone().fold(0.0, f64::max), lengths.fold(f64::INFINITY, f64::min));
             let kept = STEPS.iter().any(|&t| {
                 let mut step = scale(sub(mean, old_position), t);
                 if singular(v) && norm(step) > SINGULAR_REACH * shortest {
@@ -234,17 +228,10 @@ fn flatness(quads: &QuadMesh, q: usize) -> f64 {
 /// `mesh`, or at a vertex of one.
 fn on_curve(mesh: &TriMesh, features: &FeatureSet, l: &SurfacePoint) -> bool {
     let curve = |e: u32| mesh.is_boundary_edge(e) || features.contains(e);
-    let corners = mesh.faces()[l.face as usize];
-    let halfedges = mesh.face_halfedges(l.face);
-    let off: Vec<usize> = (0..3).filter(|&i| l.bary[i] < ON_EDGE).collect();
-    match off.as_slice() {
-        [a, b] => {
-            let v = corners[3 - a - b];
-            mesh.outgoing(v).any(|h| curve(mesh.edge(h)))
-        }
-        // On the edge opposite corner `a`: face halfedge `a + 1`.
-        [a] => curve(mesh.edge(halfedges[(a + 1) % 3])),
-        _ => false,
+    match l.on_face(mesh) {
+        OnFace::Corner(v) => mesh.outgoing(v).any(|h| curve(mesh.edge(h))),
+        OnFace::Side(h) => curve(mesh.edge(h)),
+        OnFace::Inside => false,
     }
 }
 
