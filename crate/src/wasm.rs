@@ -186,7 +186,7 @@ impl MeshSession {
         use crate::features::{detect_sharp, MinLength, SharpOptions};
         let mesh = self.valid_mesh()?;
         let min_length = if min_edges > 0 { MinLength::Edges(min_edges as usize) } else { MinLength::None };
-        let found = detect_sharp(mesh, &SharpOptions { threshold_degrees: degrees, min_length, prune_dangling: closed_only });
+        let found = detect_sharp(mesh, &SharpOptions { min_length, prune_dangling: closed_only, ..SharpOptions::threshold(degrees) });
         Ok(detection_object(&found)?.into())
     }
 
@@ -244,9 +244,16 @@ impl MeshSession {
     /// Places cones and computes the seamless aligned map (the whole method).
     /// Returns a [`SolveResult`]: the `place_cones` fields plus the map, its
     /// metrics and the exports of the solved mesh. Solve errors throw as
-    /// `solve_finish` says.
-    pub fn solve(&mut self, feature_edges: &[u32], alpha_smooth: Option<f64>, miq: bool, progress: &Function) -> Result<JsValue, JsValue> {
-        let schedule = self.solve_begin(feature_edges, alpha_smooth, miq, None)?;
+    /// `solve_finish` says. `creases` (may be left out): as in `solve_begin`.
+    pub fn solve(
+        &mut self,
+        feature_edges: &[u32],
+        alpha_smooth: Option<f64>,
+        miq: bool,
+        progress: &Function,
+        creases: Option<Vec<u32>>,
+    ) -> Result<JsValue, JsValue> {
+        let schedule = self.solve_begin(feature_edges, alpha_smooth, miq, creases)?;
         for c in schedule {
             self.solve_place(c, false, progress)?;
         }

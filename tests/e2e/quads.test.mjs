@@ -232,6 +232,11 @@ describe('quad mode', () => {
     assert.equal(q.defects, 0);
     assert.ok(q.sharpWithin > 0.99, `${q.sharpWithin} of the sharp edges near a quad edge`);
     assert.ok(q.distance < 0.01, `distance ${q.distance} of the diagonal`);
+    // The JSON report says which features were creases.
+    const [json] = await Promise.all([page.waitForEvent('download'), page.getByTestId('download-json').click()]);
+    const report = JSON.parse(fs.readFileSync(await json.path(), 'utf8'));
+    assert.equal(report.features.edges.length, 693);
+    assert.deepEqual(report.features.creases, report.features.edges, 'every feature came from the Creases button');
   });
 
   it('logged no unexpected console errors', () => {

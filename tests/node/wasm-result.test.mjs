@@ -164,8 +164,8 @@ test('crease_edges are the creases conemap quads follows; quads drop them where 
   assert.equal(creases.length, 32);
   const edges = session.edges().length / 2;
   assert.throws(() => session.solve_begin(creases, undefined, false, Uint32Array.of(edges)), /feature edge id \d+ is out of range/);
-  for (const c of session.solve_begin(creases, undefined, false, creases)) session.solve_place(c, false, () => {});
-  session.solve_finish(() => {});
+  // (`solve` takes the creases as its last argument; the page passes them to `solve_begin`.)
+  session.solve(creases, undefined, false, () => {}, creases);
   const r = session.quads(1000, () => {});
   assert.equal(r.dropped_crease_edges, 32);
   assert.equal(r.dropped_feature_edges, 32);

@@ -227,6 +227,8 @@ export class ResultPanel {
         // End positions too: the same form as `conemap solve --features FILE`.
         positions: Array.from(m.features?.ids() ?? [], (e) => [m.edges[2 * e]!, m.edges[2 * e + 1]!].map((v) => Array.from(m.data.positions.subarray(3 * v, 3 * v + 3)))),
         boundary_edges: m.features?.boundaryCount ?? 0,
+        // Those marked by the Creases button: the quads drop them where they fold the map.
+        creases: Array.from(m.features?.creaseIds() ?? []),
       },
       result: { ...rest, metrics: metricsOut, seam_edges: seams.length },
     };
