@@ -237,6 +237,12 @@ describe('quad mode', () => {
     const report = JSON.parse(fs.readFileSync(await json.path(), 'utf8'));
     assert.equal(report.features.edges.length, 693);
     assert.deepEqual(report.features.creases, report.features.edges, 'every feature came from the Creases button');
+    // With the quads shown: their figures, as `conemap quads --report` writes them.
+    assert.equal(report.quads.target, 3000);
+    assert.equal(report.quads.report.quads, q.quads);
+    assert.equal(report.quads.dropped_crease_edges, 0);
+    assert.equal(typeof report.quads.quantization.distortion_after, 'number');
+    assert.equal(report.quads.obj, undefined, 'no meshes in the report');
   });
 
   it('logged no unexpected console errors', () => {

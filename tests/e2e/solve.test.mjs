@@ -174,6 +174,7 @@ describe('feature editing and solving', () => {
     assert.equal(report.settings.alpha_smooth, 1);
     assert.equal(report.features.edges.length, h.features);
     assert.deepEqual(report.features.creases, [], 'the slider marks no creases');
+    assert.equal(report.quads, undefined, 'no quads shown');
     assert.equal(report.result.cones.length, r.cones);
     assert.equal(r.uv, true, 'the solve gives UVs');
     // With the parametrization: the .glb and .obj exports download.

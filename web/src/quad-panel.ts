@@ -126,6 +126,19 @@ export class QuadPanel {
     this.requestShown();
   }
 
+  /**
+   * The quads shown for the JSON report: the count asked for, the request's
+   * milliseconds and the result's figures (the quantization's and the
+   * quad mesh's, as `conemap quads --report` writes them), without the
+   * meshes and exports; null when none are shown.
+   */
+  reportSection(): Record<string, unknown> | null {
+    if (!this.shown) return null;
+    const { result, target, ms } = this.shown;
+    const { uv: _uv, positions: _positions, quads: _quads, edges: _edges, singular: _singular, obj: _obj, glb: _glb, grid_glb: _gridGlb, ...figures } = result;
+    return { target, ms, ...figures };
+  }
+
   /** The target count of the slider as it stands. */
   private get target(): number {
     return quadsOf(Number(this.el.count.value));

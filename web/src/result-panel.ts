@@ -211,12 +211,13 @@ export class ResultPanel {
     return this.uvView.projectPoint(u, v);
   }
 
-  /** The report: settings, features, mesh figures and the solver's result (without bulky arrays); null without a result. */
+  /** The report: settings, features, mesh figures, the solver's result and the quads shown (without bulky arrays); null without a result. */
   report(): Record<string, unknown> | null {
     if (!this.shown) return null;
     const { mesh: m, result: r, settings } = this.shown.run;
     const { uv: _uv, glb: _glb, obj: _obj, view: _view, seam_edges: seams, metrics, ...rest } = r;
     const metricsOut = { ...metrics, per_face_distortion: undefined };
+    const quads = this.quads.reportSection();
     return {
       tool: 'conemap',
       file: m.label,
@@ -231,6 +232,8 @@ export class ResultPanel {
         creases: Array.from(m.features?.creaseIds() ?? []),
       },
       result: { ...rest, metrics: metricsOut, seam_edges: seams.length },
+      // The quads shown of this result's map, if any.
+      ...(quads ? { quads } : {}),
     };
   }
 
