@@ -119,9 +119,11 @@ commands:
                        the mesh's creases (edges sharper than 75° on
                        curves of at least 10 % of the bounding-box
                        diagonal: a CAD part's edges, which quads cut across
-                       otherwise), dropped on each part where they fold
-                       the map (the report's detected_feature_edges counts
-                       them); --sharp none follows no crease.
+                       otherwise); where they fold the map, those next
+                       to the folds are dropped, or where that still
+                       folds, all on that part (the report's
+                       detected_feature_edges counts them); --sharp none
+                       follows no crease.
 
   quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG|none]
              [--features FEATURES.json] [--report REPORT.json] [cone options]

@@ -48,6 +48,21 @@ pub fn finer_than_grid(mesh: &TriMesh, features: &FeatureSet, s: f64) -> Feature
     }
 }
 
+/// The chains of `features` (runs between junctions, ends and the
+/// boundary) with a vertex where `near` is true, as one set.
+pub fn chains_near(mesh: &TriMesh, features: &FeatureSet, near: &[bool]) -> FeatureSet {
+    let degree = features.degrees(mesh);
+    let mut out = FeatureSet::none(mesh);
+    for chain in chains(mesh, features, &degree) {
+        if chain.edges.iter().any(|&e| mesh.edge_vertices(e).iter().any(|&v| near[v as usize])) {
+            for e in chain.edges {
+                out.set(mesh, e, true);
+            }
+        }
+    }
+    out
+}
+
 /// A run of feature edges whose inner vertices lie on exactly two feature
 /// edges and off the boundary: its edges, its length, and its two end
 /// vertices (`None` for a closed loop).
@@ -159,5 +174,27 @@ mod tests {
         assert_eq!(finer_than_grid(&mesh, &features, 0.8), along(&mesh, &[&twigs]));
         // Cells of 0.4: nothing is that short.
         assert!(finer_than_grid(&mesh, &features, 0.4).is_empty());
+    }
+
+    #[test]
+    fn chains_near_a_vertex_are_those_through_it_up_to_their_junctions() {
+        let n = 8;
+        let mesh = crate::features::test_grid(n, |_, _| 0.0);
+        // A line across the grid (row 4) with a branch up from (2, 4).
+        let left = [(0, 4), (1, 4), (2, 4)];
+        let right = [(2, 4), (3, 4), (4, 4), (5, 4), (6, 4), (7, 4), (8, 4)];
+        let branch = [(2, 4), (2, 5), (2, 6)];
+        let features = along(&mesh, &[&left, &right, &branch]);
+        let id = |(i, j): (u32, u32)| (0..mesh.n_vertices()).find(|&v| mesh.position(v as u32) == [i as f64, j as f64, 0.0]).expect("a grid point");
+        let mut near = vec![false; mesh.n_vertices()];
+        near[id((6, 4))] = true;
+        assert_eq!(chains_near(&mesh, &features, &near), along(&mesh, &[&right]));
+        // At the junction: all three chains.
+        near[id((2, 4))] = true;
+        assert_eq!(chains_near(&mesh, &features, &near), features);
+        // Off the features: none.
+        let mut off = vec![false; mesh.n_vertices()];
+        off[id((5, 1))] = true;
+        assert!(chains_near(&mesh, &features, &off).is_empty());
     }
 }

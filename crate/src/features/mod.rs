@@ -17,7 +17,7 @@ mod refine;
 
 pub use cut::{boundary_turning, cut_open, CutMesh};
 pub use detect::{detect_sharp, MinLength, SharpDetection, SharpOptions, SharpStats, CREASES};
-pub use grid::finer_than_grid;
+pub use grid::{chains_near, finer_than_grid};
 pub use refine::{
     faces_for_length, refine_for_features, refine_for_features_on, split_around, split_flipped, split_long_edges, RefineCounts, Refined,
     MAX_REFINED_FACES,

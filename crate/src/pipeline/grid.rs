@@ -7,7 +7,7 @@
 
 use super::{long_edges_refine, quad_length, solve, RefineOptions, Solution, SolveOptions, SolveProgress};
 use crate::cones;
-use crate::features::{finer_than_grid, FeatureSet};
+use crate::features::{chains_near, finer_than_grid, FeatureSet};
 use crate::mesh::TriMesh;
 use crate::param::quantize::{GridSize, IntegerGridMap, QuantizeError, QuantizeOptions, Quantizer};
 
@@ -167,9 +167,11 @@ impl GridStage {
     ///    ([`finer_than_grid`]: short dangling branches and small loops,
     ///    whose corner cones the rounding must put on grid points a cell
     ///    apart) or were detected rather than asked for
-    ///    ([`GridFeatures::detected`]: every one on a component where the
-    ///    map folds goes), it is solved again without them and kept if it
-    ///    folds less
+    ///    ([`GridFeatures::detected`]), it is solved again without them and
+    ///    kept if it folds less: first without only the detected creases'
+    ///    chains within a ring of the folds ([`chains_near`]; kept where
+    ///    that map does not fold), else without every detected crease on a
+    ///    component where the map folds
     ///    (teapot with creases above 60° at 3 000 quads: the map winds
     ///    around 6 vertices with the spout's lip, none without it). A map
     ///    that follows every feature wins ties. With such curves the first
@@ -225,7 +227,22 @@ impl GridStage {
         // 3. Without the curves finer than the grid and the detected creases
         // of the components where the map folds.
         if best.map.report.folds() > 0 {
+            // First only the detected creases' chains next to the folds,
+            // kept where that map does not fold.
+            let mut local = dropped.clone();
+            local.union(&self.detected_near_folds(input, &best));
             dropped.union(&self.detected_where_folded(input, &best));
+            if !local.is_empty() && local != dropped {
+                if self.unfollowed.as_ref().is_none_or(|u| u.key != local) {
+                    let solved = self.solve_again(input, &self.features.all.without(&local), self.options.refine, Some(size), solve_progress);
+                    self.unfollowed = Some(Resolved { key: local.clone(), solved });
+                }
+                if let Ok(map) = self.quantize(Source::Unfollowed, size, quantize, progress) {
+                    if map.report.folds() == 0 {
+                        best = Candidate { source: Source::Unfollowed, map, dropped: local };
+                    }
+                }
+            }
         }
         if best.map.report.folds() > 0 && !dropped.is_empty() {
             if self.unfollowed.as_ref().is_none_or(|u| u.key != dropped) {
@@ -260,6 +277,24 @@ impl GridStage {
         let solution = &self.solved(candidate.source).expect("a candidate's map exists").solution;
         let folded = candidate.map.fold_faces.iter().map(|&f| solution.original_face.as_ref().map_or(f, |original| original[f as usize]));
         on_components_of(input, folded, &self.features.detected)
+    }
+
+    /// The chains of the detected creases ([`chains_near`]) within a ring
+    /// of the faces where `candidate`'s map folds.
+    fn detected_near_folds(&self, input: &TriMesh, candidate: &Candidate) -> FeatureSet {
+        let solution = &self.solved(candidate.source).expect("a candidate's map exists").solution;
+        let mut near = vec![false; input.n_vertices()];
+        for &f in &candidate.map.fold_faces {
+            let f = solution.original_face.as_ref().map_or(f, |original| original[f as usize]);
+            for v in input.faces()[f as usize] {
+                for g in input.vertex_faces(v) {
+                    for w in input.faces()[g as usize] {
+                        near[w as usize] = true;
+                    }
+                }
+            }
+        }
+        chains_near(input, &self.features.detected, &near)
     }
 
     /// The map to round for `size` (step 2 of [`Self::map`]): the map solved
