@@ -614,6 +614,12 @@ fn detected_creases_are_dropped_where_they_fold_the_map() {
     assert_eq!((r.flipped, r.wound_vertices), (0, 0), "{r:?}");
     assert!(sol.features.is_empty());
     assert_eq!(check_integer_grid("cow without its creases", &sol.mesh, &sol.features, &mapped.map.uv), (0, 0));
+    // The page's slider back at this count: both maps solved again (without
+    // the creases by the folds, and without all) are kept, none solved again.
+    let uv = mapped.map.uv.clone();
+    let mut solves = 0;
+    let again = stage.map(&input, size, &QuantizeOptions::default(), &mut |_| solves += 1, &mut |_, _| {}).unwrap();
+    assert_eq!((solves, &again.dropped_features, &again.map.uv), (0, &creases, &uv));
 }
 
 /// Where a CAD part's creases fold the map only in places, only their

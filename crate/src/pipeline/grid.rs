@@ -85,7 +85,10 @@ pub struct GridStage {
     long_edges: LongEdges,
     /// The map solved again with these cut-vertex pairs of `base` cancelled.
     paired: Option<Resolved<Vec<(u32, u32)>>>,
-    /// The map solved again without these feature edges.
+    /// The map solved again without these feature edges (step 3 of
+    /// [`GridStage::map`]): without the detected creases next to the folds
+    /// (`local`), and without all those of the folding parts.
+    local: Option<Resolved<FeatureSet>>,
     unfollowed: Option<Resolved<FeatureSet>>,
 }
 
@@ -107,6 +110,7 @@ struct Resolved<K> {
 enum Source {
     Base,
     Paired,
+    Local,
     Unfollowed,
 }
 
@@ -137,7 +141,7 @@ impl GridStage {
     pub fn new(solution: Solution<'_>, features: GridFeatures, options: SolveOptions, long_edges: LongEdges) -> GridStage {
         // As solved: a low-poly fallback's edge length is not asked again.
         let options = SolveOptions { refine: solution.refine_options, ..options };
-        GridStage { base: Solved::new(solution.into_owned()), features, options, long_edges, paired: None, unfollowed: None }
+        GridStage { base: Solved::new(solution.into_owned()), features, options, long_edges, paired: None, local: None, unfollowed: None }
     }
 
     /// The features solved for (every one, the dropped ones too).
@@ -233,13 +237,13 @@ impl GridStage {
             local.union(&self.detected_near_folds(input, &best));
             dropped.union(&self.detected_where_folded(input, &best));
             if !local.is_empty() && local != dropped {
-                if self.unfollowed.as_ref().is_none_or(|u| u.key != local) {
+                if self.local.as_ref().is_none_or(|u| u.key != local) {
                     let solved = self.solve_again(input, &self.features.all.without(&local), self.options.refine, Some(size), solve_progress);
-                    self.unfollowed = Some(Resolved { key: local.clone(), solved });
+                    self.local = Some(Resolved { key: local.clone(), solved });
                 }
-                if let Ok(map) = self.quantize(Source::Unfollowed, size, quantize, progress) {
+                if let Ok(map) = self.quantize(Source::Local, size, quantize, progress) {
                     if map.report.folds() == 0 {
-                        best = Candidate { source: Source::Unfollowed, map, dropped: local };
+                        best = Candidate { source: Source::Local, map, dropped: local };
                     }
                 }
             }
@@ -274,18 +278,21 @@ impl GridStage {
     /// The detected creases ([`GridFeatures::detected`]) on the components
     /// of `input` where `candidate`'s map folds.
     fn detected_where_folded(&self, input: &TriMesh, candidate: &Candidate) -> FeatureSet {
+        on_components_of(input, self.input_fold_faces(candidate).into_iter(), &self.features.detected)
+    }
+
+    /// The faces of the input where `candidate`'s map folds (its solve's
+    /// fold faces, mapped back where that solve refined the input).
+    fn input_fold_faces(&self, candidate: &Candidate) -> Vec<u32> {
         let solution = &self.solved(candidate.source).expect("a candidate's map exists").solution;
-        let folded = candidate.map.fold_faces.iter().map(|&f| solution.original_face.as_ref().map_or(f, |original| original[f as usize]));
-        on_components_of(input, folded, &self.features.detected)
+        candidate.map.fold_faces.iter().map(|&f| solution.original_face.as_ref().map_or(f, |original| original[f as usize])).collect()
     }
 
     /// The chains of the detected creases ([`chains_near`]) within a ring
     /// of the faces where `candidate`'s map folds.
     fn detected_near_folds(&self, input: &TriMesh, candidate: &Candidate) -> FeatureSet {
-        let solution = &self.solved(candidate.source).expect("a candidate's map exists").solution;
         let mut near = vec![false; input.n_vertices()];
-        for &f in &candidate.map.fold_faces {
-            let f = solution.original_face.as_ref().map_or(f, |original| original[f as usize]);
+        for f in self.input_fold_faces(candidate) {
             for v in input.faces()[f as usize] {
                 for g in input.vertex_faces(v) {
                     for w in input.faces()[g as usize] {
@@ -344,6 +351,7 @@ impl GridStage {
     fn replace_base(&mut self, solved: Solved) {
         self.base = solved;
         self.paired = None;
+        self.local = None;
         self.unfollowed = None;
     }
 
@@ -351,6 +359,7 @@ impl GridStage {
         match source {
             Source::Base => Some(&self.base),
             Source::Paired => self.paired.as_ref()?.solved.as_ref(),
+            Source::Local => self.local.as_ref()?.solved.as_ref(),
             Source::Unfollowed => self.unfollowed.as_ref()?.solved.as_ref(),
         }
     }
@@ -360,6 +369,7 @@ impl GridStage {
         let solved = match source {
             Source::Base => Some(&mut self.base),
             Source::Paired => self.paired.as_mut().and_then(|p| p.solved.as_mut()),
+            Source::Local => self.local.as_mut().and_then(|u| u.solved.as_mut()),
             Source::Unfollowed => self.unfollowed.as_mut().and_then(|u| u.solved.as_mut()),
         };
         let solved = solved.ok_or(QuantizeError::Mismatch { what: "a map that was not solved" })?;
