@@ -17,9 +17,11 @@ use crate::param::{self, ParamError, ParamOptions, ParamProgress, Parametrizatio
 use std::borrow::Cow;
 use std::fmt;
 
+mod coarse;
 mod grid;
 mod location;
 mod parts;
+pub use coarse::{Coarse, COARSEN_ABOVE_FACES_PER_QUAD, COARSE_FACES_PER_QUAD};
 pub use grid::{grid_map, GridFeatures, GridMapped, GridStage, LongEdges};
 pub use location::{enclosing_features, ErrorLocation, MAX_LOCATION_EDGES};
 use location::Lift;

@@ -135,6 +135,52 @@ fn quads_follow_a_cad_parts_creases_unless_told_not_to() {
     }
 }
 
+/// `conemap quads` on a mesh much finer than its quads (bff-cowhead, 30 k
+/// faces, at 1 000 quads) traces them on a decimation of about
+/// `COARSE_FACES_PER_QUAD` faces per quad and moves them onto the input:
+/// every vertex of the OBJ lies on an input triangle, the quads are clean
+/// (the input's Euler characteristic and boundary loops, no flipped or
+/// degenerate quad, the singular vertices the cones), and `--full-mesh`
+/// solves on every face.
+#[test]
+fn quads_of_a_mesh_much_finer_than_its_quads_are_traced_on_a_decimation() {
+    let input = common::shared_mesh("bff-cowhead.obj");
+    let run = run_quads("bff-cowhead", "decimated", &["--quads", "1000"]);
+    let faces = run.report["decimated"]["faces"].as_u64().expect("a decimation") as f64;
+    let asked = conemap::pipeline::COARSE_FACES_PER_QUAD * 1000.0;
+    assert!((0.7 * asked..1.3 * asked).contains(&faces), "{faces} faces for {asked}");
+    assert!(run.stdout.contains("traced on a decimation"), "{}", run.stdout);
+    let triangles: Vec<[[f64; 3]; 3]> = input.faces().iter().map(|t| t.map(|v| input.position(v))).collect();
+    let diagonal = input.bounding_diagonal();
+    let text = std::fs::read_to_string(&run.obj).unwrap();
+    let vertices: Vec<[f64; 3]> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let x: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [x[0], x[1], x[2]]
+        })
+        .collect();
+    let q = &run.report["quads"];
+    assert_eq!(vertices.len() as u64, q["vertices"].as_u64().unwrap());
+    for p in &vertices {
+        let d = triangles.iter().map(|t| conemap::vec3::point_triangle_distance(*p, t)).fold(f64::INFINITY, f64::min);
+        // The OBJ's decimal digits.
+        assert!(d < 1e-6 * diagonal, "a quad vertex {d} off the input");
+    }
+    assert_eq!(q["euler_characteristic"].as_i64(), Some(input.euler_characteristic()));
+    assert_eq!(q["boundary_loops"].as_u64(), Some(input.boundary_loops().len() as u64));
+    assert_eq!((q["flipped_quads"].as_u64(), q["degenerate_quads"].as_u64(), q["non_manifold_edges"].as_u64()), (Some(0), Some(0), Some(0)));
+    assert_eq!(run.report["defects"].as_array().map(Vec::len), Some(0));
+    let singular: u64 = q["valence_histogram"]["interior"].as_object().unwrap().iter().filter(|(k, _)| *k != "4").map(|(_, n)| n.as_u64().unwrap()).sum();
+    assert_eq!(Some(singular), run.report["cones"].as_u64(), "singular vertices are the cones: {q}");
+    let full = run_quads("bff-cowhead", "full-mesh", &["--quads", "1000", "--full-mesh"]);
+    assert!(full.report["decimated"].is_null());
+    for dir in [run.dir, full.dir] {
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
 /// `solve --quads` into a `.glb`: read back as the file's f32, every seam
 /// transition is a quarter turn plus an integer translation to the last bit
 /// and every cone an integer point, with coordinates of up to about 64 grid

@@ -126,7 +126,7 @@ commands:
                        follows no crease.
 
   quads FILE -o OUT.obj|OUT.glb [--quad-size S | --quads N] [--alpha A] [--sharp DEG|none]
-             [--features FEATURES.json] [--report REPORT.json] [cone options]
+             [--features FEATURES.json] [--report REPORT.json] [--full-mesh] [cone options]
                        the quad mesh of the integer-grid map (default
                        --quads 3000): OBJ with quad faces and the grid
                        coordinates of each corner as vt; glTF with each quad
@@ -145,6 +145,12 @@ commands:
                        so; the sharp-edge figures still count them).
                        Without --sharp or --features, creases are followed
                        as for solve --grid (--sharp none: none).
+                       A mesh of more than 16 faces per quad is first
+                       decimated to about 8 per quad, keeping its boundary
+                       and feature curves; the quads traced on it are
+                       moved onto the input and untangled there (the
+                       report's decimated). --full-mesh solves on every
+                       face instead (slower, same kind of quads).
 
 options:
   -h, --help           print this help
@@ -198,6 +204,7 @@ const COMMANDS: &[(&str, &[&str])] = &[
             "--report=",
             "--quad-size=",
             "--quads=",
+            "--full-mesh",
             "-o=",
             "--output=",
         ],

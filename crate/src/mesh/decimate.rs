@@ -1,5 +1,7 @@
 //! Interior decimation: a coarser mesh of the same surface whose vertices
-//! are a subset of the input's, for a coarse-to-fine cone placement.
+//! are a subset of the input's, for a coarse-to-fine cone placement and for
+//! the quads of a mesh much finer than them ([`crate::pipeline::Coarse`]:
+//! feature-curve vertices kept too, [`decimate_keeping`]).
 //!
 //! Half-edge collapses `u -> v` of interior vertices `u` (Garland & Heckbert
 //! 1997 quadric error at `v`'s position, since `v` stays where it is), in
@@ -13,7 +15,8 @@ use crate::vec3;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-/// Smallest cosine between a face's normal before and after a collapse.
+/// Smallest cosine between a face's normal before and after a collapse
+/// ([`decimate_interior`]).
 const MAX_TURN: f64 = 0.5;
 /// Smallest ratio of twice a face's area to its longest edge squared after
 /// a collapse (rejects needles; an equilateral triangle has 0.87).
@@ -95,12 +98,22 @@ impl Ord for Candidate {
 /// (or no collapse is valid). `None` if nothing could be removed or the
 /// result does not validate as a mesh.
 pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decimated> {
+    decimate_keeping(mesh, target_interior, &vec![false; mesh.n_vertices()], MAX_TURN)
+}
+
+/// [`decimate_interior`] that also keeps the vertices marked in `keep`
+/// (and so every edge between two of them: a collapse removes only the
+/// vertex it moves), until at most `target_free` vertices neither on the
+/// boundary nor kept remain, and turns no face by more than the angle of
+/// cosine `min_turn_cos` per collapse.
+pub fn decimate_keeping(mesh: &TriMesh, target_free: usize, keep: &[bool], min_turn_cos: f64) -> Option<Decimated> {
     let nv = mesh.n_vertices();
     let pos = mesh.positions();
     let mut faces: Vec<[u32; 3]> = mesh.faces().to_vec();
     let mut alive_face = vec![true; faces.len()];
     let mut incident: Vec<Vec<u32>> = (0..nv as u32).map(|v| mesh.vertex_faces(v).collect()).collect();
-    let boundary: Vec<bool> = (0..nv as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
+    // Vertices never removed: the boundary and the kept ones.
+    let fixed: Vec<bool> = (0..nv as u32).map(|v| mesh.is_boundary_vertex(v) || keep.get(v as usize).copied().unwrap_or(false)).collect();
     let mut stamp = vec![0u32; nv];
     let mut alive = vec![true; nv];
 
@@ -129,7 +142,7 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
     // Scratch rings, reused across collapses (this loop is most of the cost).
     let (mut ring_u, mut ring_v, mut ring_w) = (Vec::new(), Vec::new(), Vec::new());
     for u in 0..nv as u32 {
-        if !boundary[u as usize] {
+        if !fixed[u as usize] {
             neighbours_into(&incident, &faces, u, &mut ring_u);
             for &v in &ring_u {
                 heap.push(Candidate { cost: cost(&quadric, u, v), from: u, to: v, stamp: (0, 0) });
@@ -137,12 +150,12 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
         }
     }
 
-    let mut interior = boundary.iter().filter(|b| !**b).count();
+    let mut free = fixed.iter().filter(|b| !**b).count();
     let mut removed = 0usize;
     // Stale candidates are dropped once they would make up most of the heap,
     // so that it stays cache-sized (its pops were most of the decimation).
     let mut compact_at = 2 * heap.len().max(1024);
-    while interior > target_interior {
+    while free > target_free {
         if heap.len() > compact_at {
             heap.retain(|c| alive[c.from as usize] && alive[c.to as usize] && c.stamp == (stamp[c.from as usize], stamp[c.to as usize]));
             compact_at = 2 * heap.len().max(1024);
@@ -154,7 +167,7 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
         }
         neighbours_into(&incident, &faces, u, &mut ring_u);
         neighbours_into(&incident, &faces, v, &mut ring_v);
-        if !collapse_is_valid(pos, &faces, &incident, u, v, &ring_u, &ring_v) {
+        if !collapse_is_valid(pos, &faces, &incident, u, v, &ring_u, &ring_v, min_turn_cos) {
             continue;
         }
         // Collapse: drop the faces on edge uv, move u's other faces to v.
@@ -173,7 +186,7 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
         alive[u as usize] = false;
         let qu = quadric[u as usize];
         quadric[v as usize].add(&qu);
-        interior -= 1;
+        free -= 1;
         removed += 1;
         stamp[v as usize] += 1;
         neighbours_into(&incident, &faces, v, &mut ring_v);
@@ -182,12 +195,12 @@ pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decim
         }
         for &w in &ring_v {
             for (a, b) in [(w, v), (v, w)] {
-                if !boundary[a as usize] {
+                if !fixed[a as usize] {
                     heap.push(Candidate { cost: cost(&quadric, a, b), from: a, to: b, stamp: (stamp[a as usize], stamp[b as usize]) });
                 }
             }
             // Edges of w to its other neighbours changed cost through w's stamp.
-            if !boundary[w as usize] {
+            if !fixed[w as usize] {
                 neighbours_into(&incident, &faces, w, &mut ring_w);
                 for &x in &ring_w {
                     if x != v {
@@ -229,8 +242,10 @@ fn neighbours_into(incident: &[Vec<u32>], faces: &[[u32; 3]], v: u32, out: &mut 
 }
 
 /// The link condition (the common neighbours of `u` and `v` are the two
-/// vertices opposite edge uv) and the shape of the faces `u` moves to `v`.
+/// vertices opposite edge uv) and the shape of the faces `u` moves to `v`
+/// (none turns by more than the angle of cosine `min_turn_cos`).
 /// `nu`, `nvv`: the sorted [`neighbours_into`] of `u` and `v`.
+#[allow(clippy::too_many_arguments)]
 fn collapse_is_valid(
     pos: &[[f64; 3]],
     faces: &[[u32; 3]],
@@ -239,6 +254,7 @@ fn collapse_is_valid(
     v: u32,
     nu: &[u32],
     nvv: &[u32],
+    min_turn_cos: f64,
 ) -> bool {
     if !nvv.contains(&u) {
         return false;
@@ -258,7 +274,7 @@ fn collapse_is_valid(
         let n0 = vec3::cross(vec3::sub(p[1], p[0]), vec3::sub(p[2], p[0]));
         let n1 = vec3::cross(vec3::sub(q[1], q[0]), vec3::sub(q[2], q[0]));
         let (a0, a1) = (vec3::norm(n0), vec3::norm(n1));
-        if a0 == 0.0 || a1 == 0.0 || vec3::dot(n0, n1) < MAX_TURN * a0 * a1 {
+        if a0 == 0.0 || a1 == 0.0 || vec3::dot(n0, n1) < min_turn_cos * a0 * a1 {
             return false;
         }
         let longest = (0..3).map(|k| { let d = vec3::sub(q[k], q[(k + 1) % 3]); vec3::dot(d, d) }).fold(0.0, f64::max);

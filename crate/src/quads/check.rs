@@ -22,7 +22,7 @@ use crate::TriMesh;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-mod box_grid;
+pub(super) mod box_grid;
 
 /// What [`check_quads`] measures beyond the figures it always computes.
 #[derive(Clone, Copy, Debug)]

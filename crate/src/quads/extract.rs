@@ -28,6 +28,7 @@ mod fill;
 mod snap;
 mod trace;
 mod untangle;
+pub(crate) use untangle::untangle;
 mod vertices;
 
 #[cfg(test)]

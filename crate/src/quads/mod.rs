@@ -3,7 +3,8 @@
 //! become the quad vertices, the integer isolines between them the quad
 //! edges, and the grid cells the quads ([`extract`]). [`check`] measures
 //! the result (topology, valences, corner angles, flips, distance to the
-//! input surface).
+//! input surface); [`project_onto`] moves quads traced on a decimation of
+//! the input onto the input.
 //!
 //! Input: a [`TriMesh`](crate::TriMesh) and one UV per face corner
 //! (`3 f + k`) in grid units that form an integer-grid map: across every
@@ -13,9 +14,11 @@
 
 pub mod check;
 pub mod extract;
+mod project;
 
 pub use check::{check_quads, CheckOptions, QuadReport};
 pub use extract::{exact_grid_uv, extract_quads, extract_quads_along, ExtractError, ExtractOptions};
+pub use project::project_onto;
 
 use crate::mesh::TriMesh;
 use crate::vec3::{barycentric_point, closest_point_barycentric, norm, sub, V3};

@@ -4,7 +4,8 @@
 
 use super::{check_writable, cone_options, grid_features, grid_option, read_input, solve_mesh, solve_options, usage, Args, Failure, ProgressLine};
 use conemap::param::quantize::{GridSize, QuantizeOptions};
-use conemap::quads::{check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
+use conemap::pipeline::Coarse;
+use conemap::quads::{check_quads, extract_quads_along, project_onto, CheckOptions, ExtractOptions, QuadReport};
 use std::path::Path;
 
 /// Quads asked for when neither `--quad-size` nor `--quads` is given.
@@ -27,23 +28,39 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let input = read_input(file)?;
     let import = clock.lap();
     let features = grid_features(args, &input.mesh)?;
-    let max_edge = conemap::pipeline::RefineOptions::for_quads(&input.mesh, grid).max_edge_length;
-    let options = solve_options(args, &input.mesh, max_edge)?.for_quads(&input.mesh, grid);
-    let solution = solve_mesh(args, file, &input.mesh, &features.all, &options)?;
+    // A mesh much finer than its quads: traced on a decimation, moved onto the input.
+    let coarse = if args.flag("--full-mesh") { None } else { Coarse::for_quads(&input.mesh, &features.all, grid) };
+    let (mesh, solved_features) = match &coarse {
+        Some(c) => (&c.mesh, c.grid_features(&input.mesh, &features)),
+        None => (&input.mesh, features.clone()),
+    };
+    let max_edge = conemap::pipeline::RefineOptions::for_quads(mesh, grid).max_edge_length;
+    let options = solve_options(args, mesh, max_edge)?.for_quads(mesh, grid);
+    let solution = solve_mesh(args, file, mesh, &solved_features.all, &options)?;
     let solve = clock.lap();
     // Solves again without the feature curves finer than the grid where
     // they fold the map (counted as quantization time).
     let bar = ProgressLine::new(args);
     let long_edges = conemap::pipeline::LongEdges::RefineFirst;
-    let mapped = conemap::pipeline::grid_map(&input.mesh, &features, &options, solution, grid, &QuantizeOptions::default(), long_edges, &mut |p| bar.solve(p), &mut |_, _| {});
+    let mapped = conemap::pipeline::grid_map(mesh, &solved_features, &options, solution, grid, &QuantizeOptions::default(), long_edges, &mut |p| bar.solve(p), &mut |_, _| {});
     bar.finish();
     let conemap::pipeline::GridMapped { solution, map, dropped_features, .. } = mapped.map_err(|e| Failure(format!("{file}: {e}"), 1))?;
     let quantize_seconds = clock.lap();
-    let quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &ExtractOptions::default()).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    // On a decimation, the quads are untangled once they are on the input.
+    let extract_options = ExtractOptions { untangle: coarse.is_none(), ..ExtractOptions::default() };
+    let mut quads = extract_quads_along(&solution.mesh, &solution.features, &map.uv, &extract_options).map_err(|e| Failure(format!("{file}: {e}"), 1))?;
+    let (dropped_features, projected) = match &coarse {
+        Some(c) => (c.input_features(&input.mesh, &dropped_features), Some(project_onto(&mut quads, &solution.mesh, &input.mesh, &features.all))),
+        None => (dropped_features, None),
+    };
     let extract = clock.lap();
-    // Every feature solved for (detected creases too), the dropped ones too.
-    let sharp = solution.solved_edges_of(&features.all);
-    let report = check_quads(&solution.mesh, &quads, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
+    // Every feature solved for (detected creases too), the dropped ones too,
+    // on the input (or where it was solved on a refinement, on that).
+    let (checked_mesh, sharp) = match &coarse {
+        Some(_) => (&input.mesh, features.all.edges().collect()),
+        None => (&*solution.mesh, solution.solved_edges_of(&features.all)),
+    };
+    let report = check_quads(checked_mesh, &quads, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
     let check = clock.lap();
 
     let data = if obj {
@@ -63,6 +80,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
             "dropped_feature_edges": dropped_features.len(),
             "detected_feature_edges": features.detected.len(),
             "distortion_seamless": solution.param.metrics.distortion,
+            "decimated": coarse.as_ref().map(|c| serde_json::json!({"faces": c.mesh.n_faces(), "vertices": c.mesh.n_vertices(), "largest_projection": projected})),
             "quantization": map.report,
             "quads": report,
             "defects": quads.defects,
@@ -72,6 +90,16 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
     }
     println!("{file}: {} vertices, {} faces, {} feature edges, {} cones", input.mesh.n_vertices(), input.mesh.n_faces(), features.all.len(), solution.placement.cones.len());
+    if let (Some(c), Some(moved)) = (&coarse, projected) {
+        println!(
+            "  traced on a decimation to {} faces ({} per quad asked; --full-mesh solves on all {}), vertices moved onto the input by at most {:.2e} ({:.3} % of the diagonal)",
+            c.mesh.n_faces(),
+            conemap::pipeline::COARSE_FACES_PER_QUAD,
+            input.mesh.n_faces(),
+            moved,
+            100.0 * moved / input.mesh.bounding_diagonal()
+        );
+    }
     super::print_dropped_features(&features, &dropped_features);
     super::print_quantization(&map.report);
     print_quads(&report, quads.defects.len());

@@ -6,13 +6,13 @@
 use crate::vec3::{add, bounds, norm, sub, V3};
 
 /// Per-query marks so an item spanning several cells is measured once.
-pub(super) struct Visited {
+pub(in crate::quads) struct Visited {
     mark: Vec<u32>,
     query: u32,
 }
 
 impl Visited {
-    pub(super) fn new(items: usize) -> Self {
+    pub(in crate::quads) fn new(items: usize) -> Self {
         Visited { mark: vec![0; items], query: 0 }
     }
     fn start(&mut self) {
@@ -32,7 +32,7 @@ impl Visited {
 
 /// A uniform grid of cubic cells over items' axis-aligned boxes (each item
 /// listed in every cell its box overlaps), for nearest-item queries.
-pub(super) struct BoxGrid {
+pub(in crate::quads) struct BoxGrid {
     origin: V3,
     cell: f64,
     dims: [usize; 3],
@@ -46,7 +46,7 @@ pub(super) struct BoxGrid {
 impl BoxGrid {
     /// The grid over `boxes` (`(lo, hi)` each): cubic cells about the mean
     /// box diagonal, at most `8 n + 64` of them.
-    pub(super) fn new(boxes: &[(V3, V3)]) -> BoxGrid {
+    pub(in crate::quads) fn new(boxes: &[(V3, V3)]) -> BoxGrid {
         let corners: Vec<V3> = boxes.iter().flat_map(|&(lo, hi)| [lo, hi]).collect();
         let (lo, hi) = bounds(&corners);
         // Non-finite coordinates (a broken input) all land in the border cells.
@@ -108,7 +108,7 @@ impl BoxGrid {
     /// cells around `p`; stops once no unvisited item can be closer than the
     /// best found or than `cutoff` (the result is then only known to exceed
     /// `cutoff`). Infinite when there are no items.
-    pub(super) fn nearest(&self, p: V3, cutoff: f64, seen: &mut Visited, mut distance: impl FnMut(u32) -> f64) -> f64 {
+    pub(in crate::quads) fn nearest(&self, p: V3, cutoff: f64, seen: &mut Visited, mut distance: impl FnMut(u32) -> f64) -> f64 {
         seen.start();
         let c = self.cell_of(p);
         let mut best = f64::INFINITY;

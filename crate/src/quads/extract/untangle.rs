@@ -55,7 +55,7 @@ const MAX_SEARCH_FACES: usize = 4_096;
 
 /// Moves the vertices of the quads that fold in 3D along the input surface
 /// until fewer fold (see the module doc); returns how many moves were kept.
-pub(super) fn untangle(mesh: &TriMesh, features: &FeatureSet, quads: &mut QuadMesh) -> usize {
+pub(crate) fn untangle(mesh: &TriMesh, features: &FeatureSet, quads: &mut QuadMesh) -> usize {
     let normals = mesh.face_normals();
     let folded: Vec<usize> = (0..quads.n_quads()).filter(|&q| is_degenerate(quads, q) || is_flipped(mesh, normals, quads, q)).collect();
     if folded.is_empty() {
