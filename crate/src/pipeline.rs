@@ -21,7 +21,7 @@ mod coarse;
 mod grid;
 mod location;
 mod parts;
-pub use coarse::{Coarse, COARSEN_ABOVE_FACES_PER_QUAD, COARSE_FACES_PER_QUAD};
+pub use coarse::{Coarse, COARSE_FACES_PER_QUAD, COARSE_MAX_DISTANCE, COARSE_MIN_TURN_COS};
 pub use grid::{grid_map, GridFeatures, GridMapped, GridStage, LongEdges};
 pub use location::{enclosing_features, ErrorLocation, MAX_LOCATION_EDGES};
 use location::Lift;

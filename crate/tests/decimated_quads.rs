@@ -21,7 +21,7 @@ fn quads_traced_on_a_decimation_lie_on_the_input_and_follow_its_features() {
     let input = TriMesh::from_raw(&subdivide_midpoint(&common::shared_raw("fandisk.obj"))).unwrap();
     let features = FeatureSet::sharp_edges(&input, 60.0);
     let grid = GridSize::Quads(2000);
-    let coarse = Coarse::for_quads(&input, &features, grid).expect("26 faces per quad are decimated");
+    let coarse = Coarse::for_quads(&input, &features, grid, COARSE_FACES_PER_QUAD).expect("26 faces per quad are decimated");
     let asked = COARSE_FACES_PER_QUAD * 2000.0;
     assert!((0.8 * asked..1.2 * asked).contains(&(coarse.mesh.n_faces() as f64)), "{} faces", coarse.mesh.n_faces());
     assert_eq!(coarse.mesh.euler_characteristic(), input.euler_characteristic());
@@ -34,7 +34,7 @@ fn quads_traced_on_a_decimation_lie_on_the_input_and_follow_its_features() {
         assert_eq!((a, b), (c, d), "a feature edge is the input's");
     }
     // Not decimated: few faces per quad.
-    assert!(Coarse::for_quads(&input, &features, GridSize::Quads(4000)).is_none());
+    assert!(Coarse::for_quads(&input, &features, GridSize::Quads(4000), COARSE_FACES_PER_QUAD).is_none());
 
     let options = SolveOptions { refine: RefineOptions::for_quads(&coarse.mesh, grid), ..SolveOptions::default() }.for_quads(&coarse.mesh, grid);
     let solution = solve(&coarse.mesh, &on_coarse, &options, &mut |_| {}).unwrap();

@@ -132,7 +132,8 @@ export function nativeQuadRows(bin, meshes) {
           input: mesh.label,
           faces,
           ms: (t.quantize + t.extract) * 1000,
-          note: `quantize ${t.quantize.toFixed(3)} s, extract ${t.extract.toFixed(3)} s (solve ${t.solve.toFixed(2)} s, check ${t.check.toFixed(3)} s); ${figuresNote(f)}`,
+          note: `quantize ${t.quantize.toFixed(3)} s, extract ${t.extract.toFixed(3)} s (solve ${t.solve.toFixed(2)} s, check ${t.check.toFixed(3)} s)`
+            + `${j.decimated ? `, traced on a decimation to ${j.decimated.faces.toLocaleString('en-US')} faces` : ''}${j.attempts > 1 ? ` (${j.attempts} attempts)` : ''}; ${figuresNote(f)}`,
           target: n,
           quantize_s: t.quantize,
           extract_s: t.extract,

@@ -149,8 +149,10 @@ commands:
                        decimated to about 8 per quad, keeping its boundary
                        and feature curves; the quads traced on it are
                        moved onto the input and untangled there (the
-                       report's decimated). --full-mesh solves on every
-                       face instead (slower, same kind of quads).
+                       report's decimated). Where they fold, they are
+                       traced again on a decimation twice as fine (below
+                       32 faces per quad: on the input) and the better
+                       kept. --full-mesh solves on every face instead.
 
 options:
   -h, --help           print this help

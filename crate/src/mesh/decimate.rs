@@ -52,6 +52,17 @@ impl Quadric {
         self.0.iter_mut().zip(&o.0).for_each(|(a, b)| *a += b);
     }
 
+    /// The weighted mean of the squared distances from `p` to the planes:
+    /// [`Self::error`] over the summed weights (the trace of the normal part).
+    fn mean_squared_distance(&self, p: [f64; 3]) -> f64 {
+        let weight = self.0[0] + self.0[4] + self.0[7];
+        if weight > 0.0 {
+            self.error(p) / weight
+        } else {
+            0.0
+        }
+    }
+
     /// `[p 1] Q [p 1]ᵀ`.
     fn error(&self, p: [f64; 3]) -> f64 {
         let x = [p[0], p[1], p[2], 1.0];
@@ -98,15 +109,28 @@ impl Ord for Candidate {
 /// (or no collapse is valid). `None` if nothing could be removed or the
 /// result does not validate as a mesh.
 pub fn decimate_interior(mesh: &TriMesh, target_interior: usize) -> Option<Decimated> {
-    decimate_keeping(mesh, target_interior, &vec![false; mesh.n_vertices()], MAX_TURN)
+    let limits = CollapseLimits { min_turn_cos: MAX_TURN, max_distance: f64::INFINITY };
+    decimate_keeping(mesh, target_interior, &vec![false; mesh.n_vertices()], limits)
+}
+
+/// What a collapse of [`decimate_keeping`] may do.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CollapseLimits {
+    /// Smallest cosine between a face's normal before and after.
+    pub min_turn_cos: f64,
+    /// Largest root-mean-square distance (area-weighted) from the kept
+    /// vertex to the planes of the input faces merged into it (the quadric
+    /// of Garland & Heckbert over its weight): a tip worn down by repeated
+    /// collapses moves away from its input faces' planes.
+    pub max_distance: f64,
 }
 
 /// [`decimate_interior`] that also keeps the vertices marked in `keep`
 /// (and so every edge between two of them: a collapse removes only the
 /// vertex it moves), until at most `target_free` vertices neither on the
-/// boundary nor kept remain, and turns no face by more than the angle of
-/// cosine `min_turn_cos` per collapse.
-pub fn decimate_keeping(mesh: &TriMesh, target_free: usize, keep: &[bool], min_turn_cos: f64) -> Option<Decimated> {
+/// boundary nor kept remain or no collapse within `limits` is left.
+pub fn decimate_keeping(mesh: &TriMesh, target_free: usize, keep: &[bool], limits: CollapseLimits) -> Option<Decimated> {
+    let min_turn_cos = limits.min_turn_cos;
     let nv = mesh.n_vertices();
     let pos = mesh.positions();
     let mut faces: Vec<[u32; 3]> = mesh.faces().to_vec();
@@ -168,6 +192,11 @@ pub fn decimate_keeping(mesh: &TriMesh, target_free: usize, keep: &[bool], min_t
         neighbours_into(&incident, &faces, u, &mut ring_u);
         neighbours_into(&incident, &faces, v, &mut ring_v);
         if !collapse_is_valid(pos, &faces, &incident, u, v, &ring_u, &ring_v, min_turn_cos) {
+            continue;
+        }
+        let mut merged = quadric[u as usize];
+        merged.add(&quadric[v as usize]);
+        if merged.mean_squared_distance(pos[v as usize]) > limits.max_distance * limits.max_distance {
             continue;
         }
         // Collapse: drop the faces on edge uv, move u's other faces to v.
@@ -324,5 +353,26 @@ mod tests {
         assert!(d.mesh.n_vertices() - boundary(&d.mesh) <= 10);
         assert_eq!(d.mesh.boundary_loops().len(), 1);
         assert_eq!(d.mesh.euler_characteristic(), 1);
+    }
+
+    /// A plate with a thin spike in its middle and a kept diagonal: the
+    /// kept vertices all stay; without a distance limit the spike's tip
+    /// is worn down to the target count, with one the tip stays.
+    #[test]
+    fn kept_vertices_stay_and_a_distance_limit_keeps_a_tip() {
+        let spike = |x: f64, y: f64| [x, y, 0.5 * (-((x - 0.5).powi(2) + (y - 0.5).powi(2)) / 0.002).exp()];
+        let fine = TriMesh::from_raw(&shapes::grid(24, 24, spike)).unwrap();
+        let tip = (0..fine.n_vertices() as u32).max_by(|&a, &b| fine.position(a)[2].total_cmp(&fine.position(b)[2])).unwrap();
+        let keep: Vec<bool> = (0..fine.n_vertices() as u32).map(|v| { let p = fine.position(v); (p[0] - p[1]).abs() < 1e-9 && v != tip }).collect();
+        assert!(keep.iter().filter(|&&k| k).count() >= 20);
+        let loose = CollapseLimits { min_turn_cos: -1.0, max_distance: f64::INFINITY };
+        let d = decimate_keeping(&fine, 4, &keep, loose).expect("decimates");
+        for v in (0..fine.n_vertices()).filter(|&v| keep[v]) {
+            assert!(d.vertex.contains(&(v as u32)), "kept vertex {v} removed");
+        }
+        assert!(!d.vertex.contains(&tip), "the tip worn down");
+        let limited = decimate_keeping(&fine, 4, &keep, CollapseLimits { max_distance: 0.01, ..loose }).expect("decimates");
+        assert!(limited.vertex.contains(&tip), "the tip kept");
+        assert!(limited.mesh.n_vertices() > d.mesh.n_vertices());
     }
 }

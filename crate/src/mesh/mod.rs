@@ -21,7 +21,7 @@ mod weld;
 #[cfg(test)]
 mod tests;
 
-pub use decimate::{decimate_interior, decimate_keeping, Decimated};
+pub use decimate::{decimate_interior, decimate_keeping, CollapseLimits, Decimated};
 pub use geometry::{wrap_angle, FaceFrames};
 pub use problem::{ElementNames, FileNames, LocatedProblem, Problem};
 pub use raw::RawMesh;

@@ -8,11 +8,14 @@
 //! input's) keeps the boundary and every vertex of a feature curve, so the
 //! curves are the input's edges, and leaves about [`COARSE_FACES_PER_QUAD`]
 //! faces per quad; the quads are then moved onto the input
-//! ([`crate::quads::project_onto`]).
+//! ([`crate::quads::project_onto`]). The CLI's `quads` traces them again
+//! on a decimation twice as fine where they fold: the cones of a
+//! decimation differ from the input's, and a few land where the quads
+//! fold in 3D (measured in `docs/STATUS.md`, session 43).
 
 use super::{quad_length, GridFeatures};
 use crate::features::FeatureSet;
-use crate::mesh::{decimate_keeping, TriMesh, NONE};
+use crate::mesh::{decimate_keeping, CollapseLimits, TriMesh, NONE};
 use crate::param::quantize::GridSize;
 
 /// Faces per quad a decimation for quads keeps. Cow subdivided once (23 k
@@ -26,9 +29,12 @@ pub const COARSE_FACES_PER_QUAD: f64 = 8.0;
 /// has; at 0.8 (37°) only the teapot's, which its input has too.
 pub const COARSE_MIN_TURN_COS: f64 = 0.8;
 
-/// Faces per quad above which a mesh is decimated for its quads: twice
-/// [`COARSE_FACES_PER_QUAD`], so a decimation at least halves the faces.
-pub const COARSEN_ABOVE_FACES_PER_QUAD: f64 = 2.0 * COARSE_FACES_PER_QUAD;
+/// Largest distance, in quads, of a kept vertex from the planes of the
+/// input faces merged into it (root mean square, [`CollapseLimits`]): the
+/// decimation wore tips down otherwise, which the quads then cut across
+/// (spot subdivided twice at 1 000 quads: 2.01 % of the diagonal from the
+/// input, 1.23 % with this, 1.52 % traced on the input; at 0.05: 1.44 %).
+pub const COARSE_MAX_DISTANCE: f64 = 0.02;
 
 /// A decimation of an input mesh that keeps its boundary and feature
 /// curves: every input edge between two kept vertices that bounds or is a
@@ -42,15 +48,16 @@ pub struct Coarse {
 }
 
 impl Coarse {
-    /// The decimation of `input` for quads of `grid` where `input` has more
-    /// than [`COARSEN_ABOVE_FACES_PER_QUAD`] faces per quad, keeping the
-    /// vertices of the feature edges `features`; `None` where it has fewer,
-    /// or the decimation removes nothing or does not give a valid mesh.
-    pub fn for_quads(input: &TriMesh, features: &FeatureSet, grid: GridSize) -> Option<Coarse> {
+    /// The decimation of `input` to about `faces_per_quad` faces per quad
+    /// of `grid` (in the CLI [`COARSE_FACES_PER_QUAD`]) where `input` has
+    /// more than twice that, keeping the vertices of the feature edges
+    /// `features`; `None` where it has fewer, or the decimation removes
+    /// nothing or does not give a valid mesh.
+    pub fn for_quads(input: &TriMesh, features: &FeatureSet, grid: GridSize, faces_per_quad: f64) -> Option<Coarse> {
         let quad = quad_length(input, grid);
         let area: f64 = input.face_areas().iter().sum();
         let quads = area / (quad * quad);
-        if !(quads.is_finite() && quads > 0.0) || (input.n_faces() as f64) <= COARSEN_ABOVE_FACES_PER_QUAD * quads {
+        if !(quads.is_finite() && quads > 0.0) || (input.n_faces() as f64) <= 2.0 * faces_per_quad * quads {
             return None;
         }
         let mut keep = vec![false; input.n_vertices()];
@@ -62,9 +69,10 @@ impl Coarse {
         // A closed surface of F faces has about F / 2 vertices; fixed ones
         // (boundary, features) each take about one face fewer.
         let fixed = (0..input.n_vertices() as u32).filter(|&v| keep[v as usize] || input.is_boundary_vertex(v)).count();
-        let target_faces = COARSE_FACES_PER_QUAD * quads;
+        let target_faces = faces_per_quad * quads;
         let target_free = ((target_faces - fixed as f64) / 2.0).max(0.0) as usize;
-        let decimated = decimate_keeping(input, target_free, &keep, COARSE_MIN_TURN_COS)?;
+        let limits = CollapseLimits { min_turn_cos: COARSE_MIN_TURN_COS, max_distance: COARSE_MAX_DISTANCE * quad };
+        let decimated = decimate_keeping(input, target_free, &keep, limits)?;
         let mut coarse_vertex = vec![NONE; input.n_vertices()];
         for (c, &v) in decimated.vertex.iter().enumerate() {
             coarse_vertex[v as usize] = c as u32;
