@@ -34,15 +34,19 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     // the input; where those quads fold, again on a decimation twice as
     // fine (or the input), keeping the better.
     let decimate = |faces_per_quad: f64| if args.flag("--full-mesh") { None } else { Coarse::for_quads(&input.mesh, &features.all, grid, faces_per_quad) };
+    let detect = clock.lap();
     let first = decimate(COARSE_FACES_PER_QUAD);
     let decimated = first.is_some();
+    let mut decimation = clock.lap();
     let mut traced = trace(args, file, &input.mesh, &features, &features.all, grid, first)?;
     if decimated && traced.folds() > 0 {
         // With the features the first kept, none dropped again: one solve
         // and rounding (the creases of an organic part folding the map
         // cost several: cow subdivided twice at 3 000 quads, 400 s).
         let kept = GridFeatures::asked(&input.mesh, features.all.without(&traced.dropped_features));
+        clock.lap();
         let finer = decimate(2.0 * COARSE_FACES_PER_QUAD);
+        decimation += clock.lap();
         if let Ok(mut again) = trace(args, file, &input.mesh, &kept, &features.all, grid, finer) {
             again.dropped_features.union(&traced.dropped_features);
             traced = Traced::better(traced, again);
@@ -73,7 +77,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
             "quantization": map.report,
             "quads": report,
             "defects": quads.defects,
-            "timings": {"import": import, "solve": solve, "quantize": quantize_seconds, "extract": extract, "check": check, "write": write},
+            "timings": {"import": import, "features": detect, "decimate": decimation, "solve": solve, "quantize": quantize_seconds, "extract": extract, "check": check, "write": write},
         });
         let text = serde_json::to_string_pretty(&json).map_err(|e| Failure(e.to_string(), 1))?;
         std::fs::write(path, text + "\n").map_err(|e| Failure(format!("{path}: cannot write: {e}"), 1))?;
@@ -96,7 +100,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     print_quads(&report, quads.defects.len());
     println!("  wrote {out}: {} quads, {} vertices", quads.n_quads(), quads.n_vertices());
     println!(
-        "  time: import {import:.3} s, cones and map {solve:.3} s, quantization {quantize_seconds:.3} s, extraction {extract:.3} s, checks {check:.3} s"
+        "  time: import {import:.3} s, features {detect:.3} s, decimation {decimation:.3} s, cones and map {solve:.3} s, quantization {quantize_seconds:.3} s, extraction {extract:.3} s, checks {check:.3} s"
     );
     Ok(())
 }
