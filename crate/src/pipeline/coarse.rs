@@ -23,10 +23,11 @@ use crate::param::quantize::GridSize;
 pub const COARSE_FACES_PER_QUAD: f64 = 8.0;
 
 /// Smallest cosine between a face's normal before and after a collapse of
-/// the decimation. The cone placement's 0.5 (60°) flattened tips: spot
-/// subdivided once at 1 000 quads got two bow-ties on a horn, bff-face,
-/// bff-bunny and teapot subdivided once one each, none of which the input
-/// has; at 0.8 (37°) only the teapot's, which its input has too.
+/// the decimation. The cone placement's 0.5 (60°) flattened tips: at
+/// 1 000 quads spot subdivided once got two bow-ties on a horn, bff-face,
+/// bff-bunny and teapot subdivided once one each, where the quads traced
+/// on the input have none (the teapot one); at 0.8 (37°) only the
+/// teapot's.
 pub const COARSE_MIN_TURN_COS: f64 = 0.8;
 
 /// Largest distance, in quads, of a kept vertex from the planes of the

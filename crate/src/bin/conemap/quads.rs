@@ -38,8 +38,13 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
     let first = decimate(COARSE_FACES_PER_QUAD);
     let decimated = first.is_some();
     let mut decimation = clock.lap();
-    let mut traced = trace(args, file, &input.mesh, &features, &features.all, grid, first)?;
-    if decimated && traced.folds() > 0 {
+    // Where the decimation's solve fails (its map folds, say), the input's.
+    let mut traced = match trace(args, file, &input.mesh, &features, &features.all, grid, first) {
+        Err(_) if decimated => trace(args, file, &input.mesh, &features, &features.all, grid, None)?,
+        traced => traced?,
+    };
+    let mut retried_on = None;
+    if traced.coarse.is_some() && traced.folds() > 0 {
         // With the features the first kept, none dropped again: one solve
         // and rounding (the creases of an organic part folding the map
         // cost several: cow subdivided twice at 3 000 quads, 400 s).
@@ -47,6 +52,7 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
         clock.lap();
         let finer = decimate(2.0 * COARSE_FACES_PER_QUAD);
         decimation += clock.lap();
+        retried_on = Some(if finer.is_some() { "a decimation twice as fine" } else { "the input" });
         if let Ok(mut again) = trace(args, file, &input.mesh, &kept, &features.all, grid, finer) {
             again.dropped_features.union(&traced.dropped_features);
             traced = Traced::better(traced, again);
@@ -92,8 +98,10 @@ pub fn quads_command(args: &Args) -> Result<(), Failure> {
             100.0 * moved / input.mesh.bounding_diagonal()
         );
     }
-    if attempts > 1 {
-        println!("  the quads of the first decimation folded: traced again on {}, the better kept", if decimated && coarse.is_none() { "the input".to_string() } else { "a decimation twice as fine".to_string() });
+    if let Some(on) = retried_on {
+        println!("  the quads of the decimation folded: traced again on {on}, the better kept");
+    } else if decimated && coarse.is_none() {
+        println!("  the map of the decimation could not be solved: traced on the input");
     }
     super::print_dropped_features(&features, &dropped_features);
     super::print_quantization(&map.report);
