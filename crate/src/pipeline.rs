@@ -433,7 +433,7 @@ impl Solution<'_> {
                 if a == crate::mesh::NONE || b == crate::mesh::NONE {
                     return None;
                 }
-                input.outgoing(a).find(|&h| input.head(h) == b).map(|h| input.edge(h))
+                input.edge_between(a, b)
             })
             .collect();
         out.sort_unstable();

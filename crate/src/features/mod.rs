@@ -86,7 +86,7 @@ impl FeatureSet {
             let e = ends_p
                 .iter()
                 .flat_map(|&a| ends_q.iter().map(move |&b| (a, b)))
-                .find_map(|(a, b)| mesh.outgoing(a).find(|&h| mesh.head(h) == b).map(|h| mesh.edge(h)))
+                .find_map(|(a, b)| mesh.edge_between(a, b))
                 .ok_or(FeatureError::NotAnEdge { index, vertices: [ends_p[0], ends_q[0]] })?;
             set.set(mesh, e, true);
         }

@@ -397,12 +397,11 @@ pub(super) fn refined_from(
     let mesh = TriMesh::from_welded_arrays(built.positions().to_vec(), built.faces().to_vec())
         .expect("rebuilding a valid mesh from its own arrays");
     // Each refined edge is an edge of m, half of a split edge, or new.
-    let edge_of_m = |a: u32, b: u32| m.outgoing(a).find(|&h| m.head(h) == b).map(|h| m.edge(h));
     let parent_edge = |e: u32| -> Option<u32> {
         let [a, b] = mesh.edge_vertices(e).map(|v| old[v as usize]);
         let (lo, hi) = (a.min(b) as usize, a.max(b) as usize);
         if hi < nv {
-            edge_of_m(lo as u32, hi as u32)
+            m.edge_between(lo as u32, hi as u32)
         } else if lo < nv && hi < nv + n_mid {
             let split = mid_of[hi - nv];
             m.edge_vertices(split).contains(&(lo as u32)).then_some(split)

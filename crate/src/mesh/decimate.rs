@@ -194,10 +194,12 @@ pub fn decimate_keeping(mesh: &TriMesh, target_free: usize, keep: &[bool], limit
         if !collapse_is_valid(pos, &faces, &incident, u, v, &ring_u, &ring_v, min_turn_cos) {
             continue;
         }
-        let mut merged = quadric[u as usize];
-        merged.add(&quadric[v as usize]);
-        if merged.mean_squared_distance(pos[v as usize]) > limits.max_distance * limits.max_distance {
-            continue;
+        if limits.max_distance.is_finite() {
+            let mut merged = quadric[u as usize];
+            merged.add(&quadric[v as usize]);
+            if merged.mean_squared_distance(pos[v as usize]) > limits.max_distance * limits.max_distance {
+                continue;
+            }
         }
         // Collapse: drop the faces on edge uv, move u's other faces to v.
         for f in std::mem::take(&mut incident[u as usize]) {

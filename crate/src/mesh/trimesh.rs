@@ -342,6 +342,10 @@ impl TriMesh {
         let h = self.edge_he[e as usize];
         [self.tail(h), self.head(h)]
     }
+    /// The edge joining vertices `a` and `b`, if any.
+    pub fn edge_between(&self, a: u32, b: u32) -> Option<u32> {
+        self.outgoing(a).find(|&h| self.head(h) == b).map(|h| self.edge(h))
+    }
     /// True when edge `e` has only one face.
     #[inline]
     pub fn is_boundary_edge(&self, e: u32) -> bool {

@@ -91,7 +91,7 @@ impl Coarse {
         if a == NONE || b == NONE {
             return None;
         }
-        self.mesh.outgoing(a).find(|&h| self.mesh.head(h) == b).map(|h| self.mesh.edge(h))
+        self.mesh.edge_between(a, b)
     }
 
     /// The input's feature edges `features` as edges of `mesh`.
@@ -113,8 +113,8 @@ impl Coarse {
         let mut out = FeatureSet::none(input);
         for e in features.edges() {
             let [a, b] = self.mesh.edge_vertices(e).map(|v| self.vertex[v as usize]);
-            if let Some(h) = input.outgoing(a).find(|&h| input.head(h) == b) {
-                out.set(input, input.edge(h), true);
+            if let Some(e) = input.edge_between(a, b) {
+                out.set(input, e, true);
             }
         }
         out

@@ -294,10 +294,9 @@ impl GridStage {
         let mut near = vec![false; input.n_vertices()];
         for f in self.input_fold_faces(candidate) {
             for v in input.faces()[f as usize] {
-                for g in input.vertex_faces(v) {
-                    for w in input.faces()[g as usize] {
-                        near[w as usize] = true;
-                    }
+                near[v as usize] = true;
+                for w in input.one_ring(v) {
+                    near[w as usize] = true;
                 }
             }
         }
