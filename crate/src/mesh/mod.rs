@@ -7,8 +7,10 @@
 //! [`TriMesh::from_raw`] (fails with the blocking problems) → the geometry
 //! accessors on [`TriMesh`] (each computed once, on first use).
 
+pub(crate) mod box_grid;
 mod decimate;
 mod geometry;
+mod nearest;
 mod problem;
 mod raw;
 pub mod shapes;
@@ -23,6 +25,7 @@ mod tests;
 
 pub use decimate::{decimate_interior, decimate_keeping, CollapseLimits, Decimated};
 pub use geometry::{wrap_angle, FaceFrames};
+pub use nearest::{Nearest, NearestFace};
 pub use problem::{ElementNames, FileNames, LocatedProblem, Problem};
 pub use raw::RawMesh;
 pub use subdivide::subdivide_midpoint;

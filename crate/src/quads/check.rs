@@ -11,18 +11,17 @@
 //!
 //! Distances are exact point-to-triangle (or point-to-segment) distances,
 //! found with a uniform grid over the primitives' bounding boxes
-//! ([`box_grid`]), so the cost is about linear in the number of samples and
+//! ([`crate::mesh::box_grid`]), so the cost is about linear in the number of samples and
 //! primitives.
 
 use super::{OnFace, QuadMesh, SurfacePoint};
-use box_grid::{BoxGrid, Visited};
+use crate::mesh::box_grid::{BoxGrid, Visited};
 use crate::mesh::UnionFind;
 use crate::vec3::{add, angle, bounds, cross, dot, midpoint, norm, point_segment_distance, point_triangle_distance, scale, sub, V3};
 use crate::TriMesh;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-pub(super) mod box_grid;
 
 /// What [`check_quads`] measures beyond the figures it always computes.
 #[derive(Clone, Copy, Debug)]

@@ -1,18 +1,18 @@
 //! A uniform grid over axis-aligned boxes for nearest-item queries: the
-//! spatial index behind the check's distances (samples to triangles) and
-//! its sharp-edge test (samples to quad edges), about linear in the number
-//! of samples and items.
+//! spatial index behind the quad check's distances (samples to triangles)
+//! and sharp-edge test (samples to quad edges) and behind
+//! [`super::NearestFace`], about linear in the number of queries and items.
 
 use crate::vec3::{add, bounds, norm, sub, V3};
 
 /// Per-query marks so an item spanning several cells is measured once.
-pub(in crate::quads) struct Visited {
+pub(crate) struct Visited {
     mark: Vec<u32>,
     query: u32,
 }
 
 impl Visited {
-    pub(in crate::quads) fn new(items: usize) -> Self {
+    pub(crate) fn new(items: usize) -> Self {
         Visited { mark: vec![0; items], query: 0 }
     }
     fn start(&mut self) {
@@ -32,7 +32,7 @@ impl Visited {
 
 /// A uniform grid of cubic cells over items' axis-aligned boxes (each item
 /// listed in every cell its box overlaps), for nearest-item queries.
-pub(in crate::quads) struct BoxGrid {
+pub(crate) struct BoxGrid {
     origin: V3,
     cell: f64,
     dims: [usize; 3],
@@ -46,7 +46,7 @@ pub(in crate::quads) struct BoxGrid {
 impl BoxGrid {
     /// The grid over `boxes` (`(lo, hi)` each): cubic cells about the mean
     /// box diagonal, at most `8 n + 64` of them.
-    pub(in crate::quads) fn new(boxes: &[(V3, V3)]) -> BoxGrid {
+    pub(crate) fn new(boxes: &[(V3, V3)]) -> BoxGrid {
         let corners: Vec<V3> = boxes.iter().flat_map(|&(lo, hi)| [lo, hi]).collect();
         let (lo, hi) = bounds(&corners);
         // Non-finite coordinates (a broken input) all land in the border cells.
@@ -108,7 +108,7 @@ impl BoxGrid {
     /// cells around `p`; stops once no unvisited item can be closer than the
     /// best found or than `cutoff` (the result is then only known to exceed
     /// `cutoff`). Infinite when there are no items.
-    pub(in crate::quads) fn nearest(&self, p: V3, cutoff: f64, seen: &mut Visited, mut distance: impl FnMut(u32) -> f64) -> f64 {
+    pub(crate) fn nearest(&self, p: V3, cutoff: f64, seen: &mut Visited, mut distance: impl FnMut(u32) -> f64) -> f64 {
         seen.start();
         let c = self.cell_of(p);
         let mut best = f64::INFINITY;
