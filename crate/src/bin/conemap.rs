@@ -570,6 +570,16 @@ impl ProgressLine {
         }
     }
 
+    fn quads(&self, p: conemap::pipeline::QuadProgress) {
+        use conemap::pipeline::QuadProgress::*;
+        match p {
+            Decimate { faces_per_quad } => self.say(|| format!("decimating to {faces_per_quad} faces per quad")),
+            Solve(p) => self.solve(p),
+            Quantize { done, total } => self.say(|| format!("quantization: {done} of {total} integers rounded")),
+            Extract => self.say(|| "quad extraction".to_string()),
+        }
+    }
+
     fn finish(&self) {
         if let Some(bar) = &self.0 {
             bar.finish_and_clear();
