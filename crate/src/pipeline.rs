@@ -22,7 +22,7 @@ mod grid;
 mod location;
 mod parts;
 mod quad_stage;
-pub use coarse::{Coarse, COARSE_FACES_PER_QUAD, COARSE_MAX_DISTANCE, COARSE_MIN_TURN_COS};
+pub use coarse::{corner_values_onto, Coarse, COARSE_FACES_PER_QUAD, COARSE_MAX_DISTANCE, COARSE_MIN_TURN_COS};
 pub use grid::{grid_map, GridFeatures, GridMapped, GridStage, LongEdges};
 pub use quad_stage::{Attempts, Decimation, QuadOptions, QuadProgress, QuadStage, QuadTimings, QuadsError, TracedQuads};
 pub use location::{enclosing_features, ErrorLocation, MAX_LOCATION_EDGES};

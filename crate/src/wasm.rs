@@ -5,10 +5,13 @@
 
 use crate::cones::{self, BoundaryMode, ComponentFigures, ComponentPlacement, Cone, ConeOptions, ConePlacement, ConeProgress, ConeTimings};
 use crate::export::{self, ExportInput, ExportOptions};
-use crate::param::quantize::{GridSize, QuantizeOptions, QuantizeReport};
+use crate::param::quantize::{GridSize, QuantizeReport};
 use crate::param::{self, Metrics, ParamOptions, ParamProgress, ParamTimings};
-use crate::quads::{self, check_quads, extract_quads_along, CheckOptions, ExtractOptions, QuadReport};
-use crate::pipeline::{FeatureAlignment, GridFeatures, GridMapped, GridStage, LongEdges, RefineOptions, Solution, SolveError, SolveOptions, SolveProgress, SolveStage};
+use crate::quads::{self, QuadReport};
+use crate::pipeline::{
+    corner_values_onto, Decimation, FeatureAlignment, GridFeatures, GridStage, LongEdges, QuadOptions, QuadProgress, QuadStage, QuadTimings, QuadsError, RefineOptions, Solution,
+    SolveError, SolveOptions, SolveProgress, SolveStage, TracedQuads,
+};
 use crate::features::{FeatureSet, RefineCounts};
 use crate::io::gltf::GltfSource;
 use crate::io::{self, InputFile};
@@ -68,8 +71,9 @@ pub struct MeshSession {
     mesh: Option<TriMesh>,
     /// The solve in progress through the `solve_*` steps.
     job: Option<Job>,
-    /// The last solve's map, kept for `quads` (and its quantizer, set up on first use).
-    grid: Option<GridStage>,
+    /// The last solve's map, kept for `quads` (and its quantizer, set up on
+    /// first use), with the solves of the decimations `quads` traced on.
+    grid: Option<QuadStage>,
     refine: RefineOptions,
     boundary: BoundaryMode,
 }
@@ -319,18 +323,27 @@ impl MeshSession {
         let sol = stage.finish(mesh, &features, placed, &mut solve_progress(progress)).map_err(fail)?;
         let result = self.solution_object(mesh, &features, &sol)?;
         // (The stage keeps the settings as solved: a low-poly fallback's edge length is not asked again.)
-        self.grid = Some(GridStage::new(sol.into_owned(), GridFeatures::with_creases(features, &creases), options, LongEdges::RefineFirst));
+        let solved = sol.into_owned();
+        let features = GridFeatures::with_creases(features, &creases);
+        let solved = GridStage::new(solved, features.clone(), options, LongEdges::RefineFirst);
+        self.grid = Some(QuadStage::with_solved(solved, features, QuadOptions { solve: options, ..QuadOptions::default() }));
         Ok(result)
     }
 
     /// The integer-grid map of the last solve for about `quads` grid cells
     /// and the quad mesh traced on it (a [`QuadsResult`]), by
-    /// [`GridStage::map`]: re-runs only quantization and extraction, unless
-    /// this grid asks for a solve that the last calls did not (the first
-    /// call on a mesh with edges longer than a quad mesh wants, opposite
-    /// cones the grid puts closer than a cell's diagonal, feature curves
-    /// finer than a grid that folds the map). Throws when nothing was
-    /// solved yet, or with the quantization error (a free boundary, say).
+    /// [`QuadStage::quads`]: on a mesh of more than twice
+    /// [`crate::pipeline::COARSE_FACES_PER_QUAD`] faces per quad, traced on
+    /// a decimation solved for this grid and moved onto the mesh (the
+    /// grid map carried back to the mesh's triangles by
+    /// [`corner_values_onto`]); otherwise on the solve's map, re-running
+    /// only quantization and extraction unless this grid asks for a solve
+    /// that the last calls did not (the first call on a mesh with edges
+    /// longer than a quad mesh wants, opposite cones the grid puts closer
+    /// than a cell's diagonal, feature curves finer than a grid that folds
+    /// the map). Throws when nothing was solved yet, with the solve error
+    /// as `solve_finish` does, or with the quantization error (a free
+    /// boundary, say).
     pub fn quads(&mut self, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
         self.valid_mesh()?;
         // Out of the session while it runs, so that the result may borrow
@@ -344,26 +357,29 @@ impl MeshSession {
 
 impl MeshSession {
     /// [`MeshSession::quads`] on `grid`.
-    fn quads_on(&self, grid: &mut GridStage, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
+    fn quads_on(&self, grid: &mut QuadStage, quads: u32, progress: &Function) -> Result<JsValue, JsValue> {
         let input = self.valid_mesh()?;
-        let size = GridSize::Quads(quads as usize);
-        // Every feature asked for, the dropped ones too (the map borrows the stage).
-        let requested = grid.features().clone();
-        let creases = grid.detected_features().clone();
-        let quantizing = &mut |done, total| notify(progress, "quantization", done, total, None);
-        let mapped = grid.map(input, size, &QuantizeOptions::default(), &mut solve_progress(progress), quantizing);
-        let GridMapped { solution: sol, map, dropped_features: dropped, cancelled_pairs } = mapped.map_err(|e| JsError::new(&e.to_string()))?;
-        notify(progress, "quad extraction", 0, 0, None);
-        let quad_mesh = extract_quads_along(&sol.mesh, &sol.features, &map.uv, &ExtractOptions::default()).map_err(|e| JsError::new(&e.to_string()))?;
-        let sharp = sol.solved_edges_of(&requested);
-        let report = check_quads(&sol.mesh, &quad_mesh, &CheckOptions { sharp_edges: &sharp, ..CheckOptions::default() });
-        let uv: Vec<f32> = sol.input_corner_values(input, &map.uv).iter().flat_map(|p| p.map(|c| c as f32)).collect();
+        let creases = grid.features().detected.clone();
+        let traced = grid.quads(input, GridSize::Quads(quads as usize), &mut |p| quad_progress(progress, p)).map_err(|e| match e {
+            QuadsError::Solve(e) => solve_error(&e),
+            e => JsError::new(&e.to_string()).into(),
+        })?;
+        let TracedQuads { solution: sol, map, dropped_features: dropped, cancelled_pairs, quads: quad_mesh, report, decimation, timings, .. } = traced;
+        let corner_uv = match decimation {
+            Some(_) => corner_values_onto(&sol.mesh, &map.uv, input),
+            None => sol.input_corner_values(input, &map.uv),
+        };
+        let uv: Vec<f32> = corner_uv.iter().flat_map(|p| p.map(|c| c as f32)).collect();
         let positions: Vec<f32> = quad_mesh.positions.iter().flat_map(|p| p.map(|c| c as f32)).collect();
         let corners: Vec<u32> = quad_mesh.quads.iter().flatten().copied().collect();
         let edges: Vec<u32> = quads::check::quad_edges(&quad_mesh).iter().flat_map(|e| e.vertices).collect();
         let singular: Vec<u32> = report.singular_vertices.iter().filter(|v| !v.boundary).flat_map(|v| [v.vertex, v.valence]).collect();
         let grid_options = ExportOptions { grid_units: true, checker_cell: Some(1.0), ..ExportOptions::default() };
-        let grid_glb = self.export_solved(sol, &map.uv, |input| export::write_glb(input, &grid_options))?;
+        // On a decimation, the input's triangles with the map carried back.
+        let grid_glb = match decimation {
+            Some(_) => self.export_corners(None, &corner_uv, |input| export::write_glb(input, &grid_options))?,
+            None => self.export_solved(&sol, &map.uv, |input| export::write_glb(input, &grid_options))?,
+        };
         let obj = export::quads::write_quad_obj(&quad_mesh, &format!("{} quads, grid cell {}", quad_mesh.n_quads(), map.report.grid_size));
         Ok(to_js(&QuadsResult {
             quantization: &map.report,
@@ -381,10 +397,22 @@ impl MeshSession {
             solved_faces: sol.mesh.n_faces(),
             inserted_vertices: sol.splits,
             refinement: &sol.refinement,
+            decimated: decimation,
+            timings,
             obj: Uint8Array::from(obj.as_bytes()),
             glb: Uint8Array::from(&export::quads::write_quad_glb(&quad_mesh)[..]),
             grid_glb: Uint8Array::from(&grid_glb[..]),
         })?)
+    }
+}
+
+/// Reports a quad request's stage on `progress` as the solve's are.
+fn quad_progress(progress: &Function, p: QuadProgress) {
+    match p {
+        QuadProgress::Decimate { .. } => notify(progress, "decimation", 0, 0, None),
+        QuadProgress::Solve(p) => solve_progress(progress)(p),
+        QuadProgress::Quantize { done, total } => notify(progress, "quantization", done, total, None),
+        QuadProgress::Extract => notify(progress, "quad extraction", 0, 0, None),
     }
 }
 
@@ -406,15 +434,22 @@ impl MeshSession {
     /// `uv`: the input's own attributes when the solve split nothing, else
     /// the refined mesh (exactly, with its split edges).
     fn export_solved<R>(&self, sol: &Solution, uv: &[[f64; 2]], write: impl FnOnce(&ExportInput) -> R) -> Result<R, JsError> {
+        self.export_corners((sol.splits > 0).then_some(&*sol.mesh), uv, write)
+    }
+
+    /// `write` applied to the export input of the input mesh (with its own
+    /// attributes), or of its refinement `refined`, with per-corner `uv`.
+    fn export_corners<R>(&self, refined: Option<&TriMesh>, uv: &[[f64; 2]], write: impl FnOnce(&ExportInput) -> R) -> Result<R, JsError> {
         let solved_raw;
-        let raw = if sol.splits > 0 {
-            solved_raw = RawMesh { positions: sol.mesh.positions().to_vec(), triangles: sol.mesh.faces().to_vec() };
-            &solved_raw
-        } else {
-            &self.raw
+        let (raw, mesh) = match refined {
+            Some(mesh) => {
+                solved_raw = RawMesh { positions: mesh.positions().to_vec(), triangles: mesh.faces().to_vec() };
+                (&solved_raw, mesh)
+            }
+            None => (&self.raw, self.valid_mesh()?),
         };
-        let mut input = ExportInput::new(raw, &sol.mesh, uv).map_err(|e| JsError::new(&e.to_string()))?;
-        if let (Some(source), 0) = (&self.source, sol.splits) {
+        let mut input = ExportInput::new(raw, mesh, uv).map_err(|e| JsError::new(&e.to_string()))?;
+        if let (Some(source), None) = (&self.source, refined) {
             input = input.with_gltf_source(source, &self.files[0], &self.files[1..]);
         }
         Ok(write(&input))
@@ -632,6 +667,10 @@ struct QuadsResult<'a> {
     solved_faces: usize,
     inserted_vertices: usize,
     refinement: &'a RefineCounts,
+    /// The decimation the quads were traced on (`null`: on the mesh solved),
+    /// and the seconds per stage.
+    decimated: Option<Decimation>,
+    timings: QuadTimings,
     /// The quad mesh as OBJ (UTF-8) and binary glTF.
     #[serde(with = "serde_wasm_bindgen::preserve")]
     obj: Uint8Array,

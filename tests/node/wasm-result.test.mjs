@@ -113,6 +113,39 @@ test('quads of a low-poly mesh are traced on a map solved again on its refinemen
   assert.equal(r2.solved_faces, r.solved_faces);
 });
 
+test('quads of a mesh much finer than its quads are traced on a decimation, moved onto the mesh, the grid map carried back', () => {
+  // 30 faces per quad at 1 000 quads: decimated to about 8.
+  const session = open(sharedMesh('bff-cowhead'));
+  const faces = session.indices().length / 3;
+  session.solve(new Uint32Array(), undefined, false, () => {});
+  const stages = new Set();
+  const r = session.quads(1000, (stage) => stages.add(stage));
+  assert.ok(stages.has('decimation') && stages.has('rounding') && stages.has('quantization'), [...stages].join(', '));
+  assert.ok(r.decimated && r.decimated.faces < faces / 2 && r.decimated.faces > 4 * 1000, JSON.stringify(r.decimated));
+  assert.equal(r.solved_faces, r.decimated.faces, 'the map solved on the decimation');
+  assert.ok(r.timings.decimate > 0 && r.timings.solve > 0 && r.timings.quantize > 0, JSON.stringify(r.timings));
+  // The quads against the input: the figures the CLI's quads checks.
+  assert.equal(r.defects, 0);
+  assert.equal(r.report.euler_characteristic, 1);
+  assert.equal(r.report.boundary_loops, 1);
+  assert.equal(r.report.flipped_quads + r.report.degenerate_quads, 0);
+  const distance = Math.max(r.report.distance_quads_to_input_relative, r.report.distance_input_to_quads_relative);
+  assert.ok(distance < 0.015, `distance ${distance}`);
+  assert.ok(r.decimated.largest_projection > 0);
+  // The grid map on every input corner, no input triangle turned over in it.
+  assert.equal(r.uv.length, 6 * faces);
+  let turned = 0;
+  for (let f = 0; f < faces; f++) {
+    const u = r.uv.subarray(6 * f, 6 * f + 6);
+    if ((u[2] - u[0]) * (u[5] - u[1]) - (u[3] - u[1]) * (u[4] - u[0]) <= 0) turned++;
+  }
+  assert.equal(turned, 0, `${turned} input triangles turned over in the carried map`);
+  const again = new Set();
+  const r2 = session.quads(1000, (stage) => again.add(stage));
+  assert.deepEqual([...again], ['quantization', 'quad extraction'], 'the same count: the decimation and its solve kept');
+  assert.equal(r2.report.quads, r.report.quads);
+});
+
 test('quads cancel the opposite cones a coarse grid cannot keep apart, solving again only when those pairs change', () => {
   const session = open(sharedMesh('cow'));
   const solved = session.solve(new Uint32Array(), undefined, false, () => {});

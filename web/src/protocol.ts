@@ -320,11 +320,28 @@ export interface QuadReport {
   defects: number;
 }
 
+/** A decimation quads were traced on (crate `pipeline::Decimation`). */
+export interface QuadDecimation {
+  faces: number;
+  vertices: number;
+  /** The farthest a quad vertex moved onto the input (model units). */
+  largest_projection: number;
+}
+
+/** Seconds per stage of a quads request (crate `pipeline::QuadTimings`). */
+export interface QuadTimings {
+  decimate: number;
+  solve: number;
+  quantize: number;
+  extract: number;
+  check: number;
+}
+
 /** What the wasm `quads` returns (crate `wasm::QuadsResult`, field for field). */
 export interface QuadsResult {
   quantization: QuantizeReport;
   report: QuadReport;
-  /** The integer-grid map in grid units (one cell = 1), two per input face corner 3f+k. */
+  /** The integer-grid map in grid units (one cell = 1), two per input face corner 3f+k (on a decimation: its map carried back to the input's triangles). */
   uv: Float32Array;
   /** The quad mesh: xyz per vertex, 4 vertex ids per quad (CCW), 2 per edge. */
   positions: Float32Array;
@@ -345,6 +362,10 @@ export interface QuadsResult {
   solved_faces: number;
   inserted_vertices: number;
   refinement: RefineCounts;
+  /** The decimation of the input the quads were traced on and moved from (null: traced on the mesh solved). */
+  decimated: QuadDecimation | null;
+  /** Seconds per stage of the request (decimation, its solve, quantization, extraction, checks). */
+  timings: QuadTimings;
   /** The quad mesh as OBJ (UTF-8) and as binary glTF; the input mesh with the grid UVs as binary glTF. */
   obj: Uint8Array;
   glb: Uint8Array;
@@ -368,7 +389,8 @@ export const QUAD_REPORT_KEYS = {
 } as const satisfies Keys<QuadReport>;
 export const QUADS_RESULT_KEYS = {
   quantization: true, report: true, uv: true, positions: true, quads: true, edges: true, singular: true, defects: true,
-  cones: true, cancelled_pairs: true, dropped_feature_edges: true, dropped_crease_edges: true, solved_faces: true, inserted_vertices: true, refinement: true, obj: true, glb: true, grid_glb: true,
+  cones: true, cancelled_pairs: true, dropped_feature_edges: true, dropped_crease_edges: true, solved_faces: true, inserted_vertices: true, refinement: true,
+  decimated: true, timings: true, obj: true, glb: true, grid_glb: true,
 } as const satisfies Keys<QuadsResult>;
 
 /** A solve as the page receives it: the wasm result and what the worker adds. */

@@ -282,6 +282,8 @@ export class QuadPanel {
       frac = remaining ? step / remaining : undefined;
     } else if (stage === 'quad extraction') {
       text = 'Quad extraction';
+    } else if (stage === 'decimation') {
+      text = 'Decimating the mesh for the quads';
     } else if (stage !== 'starting') {
       // The map solved again for this quad size (edges split, or cone pairs cancelled).
       text = `Map for this quad size: ${stage}`;
@@ -323,7 +325,10 @@ function quadTable(s: Shown, counts: ReturnType<typeof valenceCounts>): HTMLDLis
   if (r.distance_quads_to_input_relative !== undefined) {
     rows.push(['Distance to input (of bbox diagonal)', `${fmt(r.distance_quads_to_input_relative * 100, 2)} %`]);
   }
-  if (s.result.refinement.long_edges > 0) {
+  const decimated = s.result.decimated;
+  if (decimated) {
+    rows.push(['Traced on', `a decimation to ${fmtInt(decimated.faces)} triangles, moved onto the mesh (checkerboard: its grid map carried back)`]);
+  } else if (s.result.refinement.long_edges > 0) {
     rows.push(['Solved on', `${fmtInt(s.result.solved_faces)} triangles (long edges split for quads)`]);
   }
   rows.push(
@@ -355,6 +360,7 @@ function quadsHook(s: Shown, counts: ReturnType<typeof valenceCounts>, gridCheck
     droppedFeatures: s.result.dropped_feature_edges,
     droppedCreases: s.result.dropped_crease_edges,
     solvedFaces: r.solved_faces,
+    decimatedFaces: r.decimated?.faces ?? null,
     insertedVertices: r.inserted_vertices,
     uvCorners: r.uv.length / 2,
     gridChecker,

@@ -68,6 +68,8 @@ export interface QuadsHook {
   /** Faces of the mesh the map was solved on, and the vertices inserted into the input for it. */
   solvedFaces: number;
   insertedVertices: number;
+  /** Faces of the decimation the quads were traced on (null: traced on the mesh solved). */
+  decimatedFaces: number | null;
   /** Face corners the grid UVs cover (2 numbers each). */
   uvCorners: number;
   /** The 3D checker is drawn from the grid UVs. */

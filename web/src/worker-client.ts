@@ -274,10 +274,12 @@ export class MeshWorker {
   /**
    * The integer-grid map and quad mesh of the last solve for about `quads`
    * grid cells, from the worker whose session finished it (only quantization
-   * and extraction run). Rejects when the last solve did not succeed, or the
+   * and extraction run, or, on a mesh much finer than its quads, a decimation
+   * and its solve). Rejects when the last solve did not succeed, or the
    * worker was replaced since (its session, and the map, are gone), and with the
    * library's error when quantization fails; `onProgress` gets the stages
-   * 'quantization' (forms rounded, forms) and 'quad extraction'.
+   * 'decimation', the solve's, 'quantization' (forms rounded, forms) and
+   * 'quad extraction'.
    */
   quads(quads: number, onProgress: ProgressFn = () => {}): Promise<QuadsResult> {
     if (this.solvedIn !== this.restarts) {

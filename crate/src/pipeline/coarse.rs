@@ -15,8 +15,9 @@
 
 use super::{quad_length, GridFeatures};
 use crate::features::FeatureSet;
-use crate::mesh::{decimate_keeping, CollapseLimits, TriMesh, NONE};
+use crate::mesh::{decimate_keeping, CollapseLimits, NearestFace, TriMesh, NONE};
 use crate::param::quantize::GridSize;
+use crate::vec3::{barycentric_point, cross, dot, sub, V3};
 
 /// Faces per quad a decimation for quads keeps. Cow subdivided once (23 k
 /// faces, 7.7 per quad at 3 000) rounds as cleanly as the cow itself.
@@ -55,12 +56,11 @@ impl Coarse {
     /// `features`; `None` where it has fewer, or the decimation removes
     /// nothing or does not give a valid mesh.
     pub fn for_quads(input: &TriMesh, features: &FeatureSet, grid: GridSize, faces_per_quad: f64) -> Option<Coarse> {
-        let quad = quad_length(input, grid);
-        let area: f64 = input.face_areas().iter().sum();
-        let quads = area / (quad * quad);
-        if !(quads.is_finite() && quads > 0.0) || (input.n_faces() as f64) <= 2.0 * faces_per_quad * quads {
+        if !Coarse::wanted(input, grid, faces_per_quad) {
             return None;
         }
+        let quad = quad_length(input, grid);
+        let quads = input.face_areas().iter().sum::<f64>() / (quad * quad);
         let mut keep = vec![false; input.n_vertices()];
         for e in features.edges() {
             for v in input.edge_vertices(e) {
@@ -82,6 +82,14 @@ impl Coarse {
         // Every feature edge is kept (its ends are, and a collapse only
         // removes the vertex it moves).
         features.edges().all(|e| coarse.coarse_edge(input, e).is_some()).then_some(coarse)
+    }
+
+    /// Whether `input` has more than twice `faces_per_quad` faces per quad
+    /// of `grid` ([`Coarse::for_quads`] decimates it).
+    pub fn wanted(input: &TriMesh, grid: GridSize, faces_per_quad: f64) -> bool {
+        let quad = quad_length(input, grid);
+        let quads = input.face_areas().iter().sum::<f64>() / (quad * quad);
+        quads.is_finite() && quads > 0.0 && (input.n_faces() as f64) > 2.0 * faces_per_quad * quads
     }
 
     /// The edge of `mesh` that is input edge `e`, if both its ends are kept
@@ -118,5 +126,73 @@ impl Coarse {
             }
         }
         out
+    }
+}
+
+/// Per face corner of `onto`, the value of the piecewise linear per-corner
+/// `values` of `from` (a decimation's map, say) at that corner: each face of
+/// `onto` takes the linear function of the face of `from` nearest its
+/// centroid (among those facing its way), extended over the plane, so that
+/// its three corners stay in one chart of a map with seams. Where `from`
+/// is `onto`'s decimation, neighbours that take different faces of `from`
+/// differ at their shared corners by the distance to `from` times the
+/// map's change of gradient (or, across a seam, by the seam's transition).
+pub fn corner_values_onto(from: &TriMesh, values: &[[f64; 2]], onto: &TriMesh) -> Vec<[f64; 2]> {
+    debug_assert_eq!(values.len(), 3 * from.n_faces());
+    if from.n_faces() == 0 {
+        return vec![[0.0; 2]; 3 * onto.n_faces()];
+    }
+    let mut locator = NearestFace::new(from);
+    let normals = onto.face_normals();
+    let mut out = Vec::with_capacity(3 * onto.n_faces());
+    for (f, t) in onto.faces().iter().enumerate() {
+        let corners = t.map(|v| onto.position(v));
+        let centroid = barycentric_point(&corners, [1.0 / 3.0; 3]);
+        let g = locator.nearest(centroid, Some(normals[f])).expect("a mesh with faces").face as usize;
+        let triangle = from.faces()[g].map(|v| from.position(v));
+        for p in corners {
+            let bary = plane_barycentric(p, &triangle);
+            let value = |k: usize| (0..3).map(|i| bary[i] * values[3 * g + i][k]).sum::<f64>();
+            out.push([value(0), value(1)]);
+        }
+    }
+    out
+}
+
+/// The barycentric coordinates (any sign) of `p`'s projection onto the
+/// plane of `t`; those of the nearest point of `t` where `t` is degenerate.
+fn plane_barycentric(p: V3, t: &[V3; 3]) -> [f64; 3] {
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    let area2 = dot(n, n);
+    if !(area2 > 0.0) {
+        return crate::vec3::closest_point_barycentric(p, t);
+    }
+    let a = dot(cross(sub(t[2], t[1]), sub(p, t[1])), n) / area2;
+    let b = dot(cross(sub(t[0], t[2]), sub(p, t[2])), n) / area2;
+    [a, b, 1.0 - a - b]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+
+    /// A linear function of position on a decimation of a plane, carried
+    /// back to the plane's triangles, is that function at their corners.
+    #[test]
+    fn a_linear_map_of_a_decimated_plane_comes_back_exactly() {
+        let fine = TriMesh::from_raw(&shapes::grid(16, 12, |x, y| [x, y, 0.3 * x - 0.2 * y])).unwrap();
+        let keep = vec![false; fine.n_vertices()];
+        let limits = CollapseLimits { min_turn_cos: 0.5, max_distance: f64::INFINITY };
+        let coarse = decimate_keeping(&fine, 30, &keep, limits).expect("decimates").mesh;
+        assert!(coarse.n_faces() < fine.n_faces() / 2, "{} of {} faces", coarse.n_faces(), fine.n_faces());
+        let map = |p: V3| [2.0 * p[0] - p[1] + 0.5, p[0] + 3.0 * p[2]];
+        let values: Vec<[f64; 2]> = coarse.faces().iter().flat_map(|t| t.map(|v| map(coarse.position(v)))).collect();
+        let carried = corner_values_onto(&coarse, &values, &fine);
+        assert_eq!(carried.len(), 3 * fine.n_faces());
+        for (c, got) in carried.iter().enumerate() {
+            let want = map(fine.position(fine.faces()[c / 3][c % 3]));
+            assert!((got[0] - want[0]).abs() < 1e-12 && (got[1] - want[1]).abs() < 1e-12, "corner {c}: {got:?} for {want:?}");
+        }
     }
 }

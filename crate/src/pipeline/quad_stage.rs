@@ -177,6 +177,11 @@ impl QuadStage {
         QuadStage { features, options, full: vec![stage], coarse: Vec::new() }
     }
 
+    /// The input's features the stage solves with.
+    pub fn features(&self) -> &GridFeatures {
+        &self.features
+    }
+
     /// The quads of `input` (the mesh the stage's features are of) for
     /// `grid`: on a decimation where `input` has more than twice
     /// [`COARSE_FACES_PER_QUAD`] faces per quad, with the fallbacks of the
@@ -229,7 +234,7 @@ impl QuadStage {
         faces_per_quad: f64,
         progress: &mut dyn FnMut(QuadProgress),
     ) -> Option<Result<TracedQuads, f64>> {
-        if self.options.full_mesh {
+        if self.options.full_mesh || !Coarse::wanted(input, grid, faces_per_quad) {
             return None;
         }
         let key = (grid, faces_per_quad.to_bits(), features.all.clone());
