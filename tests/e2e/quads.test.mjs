@@ -138,13 +138,20 @@ describe('quad mode', () => {
     await page.getByTestId('show-quads').check();
   });
 
-  it('switching the quad count redraws the UV view with the new grid map', async () => {
+  it('switching the quad count redraws the UV view with the new grid map (at 500 quads traced on a decimation)', async () => {
     let h = await hooks();
+    assert.equal(h.quads.decimatedFaces, null, '6.5 faces per quad at 2 000: traced on the mesh solved');
     const before = h.uvView.bounds;
     await page.evaluate(() => window.__conemapTest.setQuadCount(500));
     h = await waitForQuads(h.quadRuns);
     assert.equal(h.quads?.target, 500, h.quadsError ?? '');
     assertGridLayout(h);
+    // 26 faces per quad: traced on a decimation, the grid map carried back to every face corner.
+    assert.ok(h.quads.decimatedFaces > 4 * 500 && h.quads.decimatedFaces < h.stats.faces / 2, `decimation of ${h.quads.decimatedFaces} faces`);
+    assert.equal(h.quads.uvCorners, 3 * h.stats.faces);
+    assert.equal(h.quads.defects, 0);
+    assert.ok(h.quads.distance < 0.02, `distance ${h.quads.distance}`);
+    assert.match(await page.getByTestId('quad-stats').innerText(), /Traced on\s+a decimation to [\d,]+ triangles/);
     // A quarter of the cells: about half the extent.
     const ratio = extent(h.uvView.bounds) / extent(before);
     assert.ok(ratio > 0.3 && ratio < 0.7, `extent ratio ${ratio} for 500 / 2000 quads`);
