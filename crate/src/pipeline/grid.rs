@@ -237,10 +237,7 @@ impl GridStage {
             local.union(&self.detected_near_folds(input, &best));
             dropped.union(&self.detected_where_folded(input, &best));
             if !local.is_empty() && local != dropped {
-                if self.local.as_ref().is_none_or(|u| u.key != local) {
-                    let solved = self.solve_again(input, &self.features.all.without(&local), self.options.refine, Some(size), solve_progress);
-                    self.local = Some(Resolved { key: local.clone(), solved });
-                }
+                self.solve_without(|s| &mut s.local, &local, input, size, solve_progress);
                 if let Ok(map) = self.quantize(Source::Local, size, quantize, progress) {
                     if map.report.folds() == 0 {
                         best = Candidate { source: Source::Local, map, dropped: local };
@@ -249,10 +246,7 @@ impl GridStage {
             }
         }
         if best.map.report.folds() > 0 && !dropped.is_empty() {
-            if self.unfollowed.as_ref().is_none_or(|u| u.key != dropped) {
-                let solved = self.solve_again(input, &self.features.all.without(&dropped), self.options.refine, Some(size), solve_progress);
-                self.unfollowed = Some(Resolved { key: dropped.clone(), solved });
-            }
+            self.solve_without(|s| &mut s.unfollowed, &dropped, input, size, solve_progress);
             if let Ok(map) = self.quantize(Source::Unfollowed, size, quantize, progress) {
                 if map.report.folds() < best.map.report.folds() {
                     best = Candidate { source: Source::Unfollowed, map, dropped };
@@ -324,6 +318,23 @@ impl GridStage {
         match &self.paired {
             Some(Resolved { solved: Some(_), .. }) => Source::Paired,
             _ => Source::Base,
+        }
+    }
+
+    /// Fills `slot` (`local` or `unfollowed`) with the map solved again for
+    /// `size` without the feature edges `dropped`, unless it holds that
+    /// map (or its failed solve) already.
+    fn solve_without(
+        &mut self,
+        slot: fn(&mut GridStage) -> &mut Option<Resolved<FeatureSet>>,
+        dropped: &FeatureSet,
+        input: &TriMesh,
+        size: GridSize,
+        solve_progress: &mut dyn FnMut(SolveProgress),
+    ) {
+        if slot(self).as_ref().is_none_or(|r| &r.key != dropped) {
+            let solved = self.solve_again(input, &self.features.all.without(dropped), self.options.refine, Some(size), solve_progress);
+            *slot(self) = Some(Resolved { key: dropped.clone(), solved });
         }
     }
 
