@@ -11,7 +11,7 @@
 //   native:quads / wasm-node:quads: integer-grid quantization and quad extraction
 //   on fandisk (sharp > 60°) and spot at about 1 000, 3 000 and 10 000 quads
 //   (scripts/lib/bench-quads.mjs), with QuadriFlow's figures as static rows
-//   native:quads-scaling: the same on spot subdivided 0-2 times (0-3 with --big):
+//   native:quads-scaling, wasm-node:quads-scaling: the same on spot subdivided 0-2 times (0-3 with --big):
 //   one surface, finer meshes; the growth exponent at each quad count
 //
 // Each entry of BENCHES is { env, stage, run(ctx) } and returns rows
@@ -414,12 +414,31 @@ function nativeQuads(ctx) {
  * faces^e at each quad count.
  */
 function nativeQuadScaling() {
-  const family = spotFamily();
-  if (family.skipped) return family;
   const bin = releaseCli();
   if (bin.skipped) return bin;
+  return quadScalingRows((meshes) => nativeQuadRows(bin, meshes));
+}
+
+/**
+ * The page's quads against mesh size, in wasm under node: the spot family
+ * solved once each, then `session.quads(n)` (wall clock: on the larger
+ * meshes the decimation and its solve included), and the exponents.
+ */
+function wasmNodeQuadScaling() {
+  const pkg = path.join(root, 'build/pkg-node/conemap.js');
+  if (!fs.existsSync(pkg)) return { skipped: 'build/pkg-node missing (run npm run build)' };
+  const wasm = createRequire(import.meta.url)(pkg);
+  // Each count once, as a first request (a repeated one reuses the decimation's solve).
+  const firstCalls = (rows) => (Array.isArray(rows) ? rows.filter((r) => !/\(again\)/.test(r.stage)) : rows);
+  return quadScalingRows((meshes) => firstCalls(wasmNodeQuadRows(wasm, meshes)));
+}
+
+/** `quadRows` of the spot family and, per quad count, the growth of ms with faces. */
+function quadScalingRows(quadRows) {
+  const family = spotFamily();
+  if (family.skipped) return family;
   const meshes = family.map(({ levels, file }) => ({ name: path.basename(file), file, sharp: null, label: `spot.obj ×4^${levels} (no features)` }));
-  const all = nativeQuadRows(bin, meshes);
+  const all = quadRows(meshes);
   if (!Array.isArray(all)) return all;
   const rows = all.filter((r) => !r.static);
   for (const n of QUAD_TARGETS) {
@@ -791,6 +810,7 @@ const BENCHES = [
   { env: 'native', stage: 'quads', run: nativeQuads, enabled: !args.has('--no-native') },
   { env: 'native', stage: 'quads-scaling', run: nativeQuadScaling, enabled: !args.has('--no-native') && !quick },
   { env: 'wasm-node', stage: 'quads', run: wasmNodeQuads, enabled: true },
+  { env: 'wasm-node', stage: 'quads-scaling', run: wasmNodeQuadScaling, enabled: !quick },
   { env: 'browser', stage: 'load', run: browserLoad, enabled: !args.has('--no-browser') && !quick },
   { env: 'browser', stage: 'features', run: browserFeatures, enabled: !args.has('--no-browser') },
   { env: 'browser', stage: 'solve-big', run: browserSolveBig, enabled: !args.has('--no-browser') && !quick },

@@ -198,7 +198,8 @@ export function wasmNodeQuadRows(wasm, meshes) {
           input: mesh.label,
           faces,
           ms,
-          note: `quantize ${quantS.toFixed(3)} s, rest ${(ms / 1000 - quantS).toFixed(3)} s (extract + check + exports); ${figuresNote(f)}`,
+          note: `quantize ${quantS.toFixed(3)} s, rest ${(ms / 1000 - quantS).toFixed(3)} s (extract + check + exports)`
+            + `${q.decimated ? `, traced on a decimation to ${q.decimated.faces.toLocaleString('en-US')} faces (decimation and its solve ${(q.timings.decimate + q.timings.solve).toFixed(3)} s)` : ''}; ${figuresNote(f)}`,
           target: n,
           quantize_s: quantS,
           rest_s: ms / 1000 - quantS,

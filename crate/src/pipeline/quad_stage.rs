@@ -157,13 +157,16 @@ struct CoarseSolve {
 pub struct QuadStage {
     features: GridFeatures,
     options: QuadOptions,
-    /// Grid stages of the input; the first is solved with `features`.
+    /// Grid stages of the input: the first solved with `features` or
+    /// given, then at most one with the features a retry kept.
     full: Vec<GridStage>,
     coarse: Vec<CoarseSolve>,
 }
 
-/// Decimations a [`QuadStage`] keeps (a request makes at most two).
+/// Decimations a [`QuadStage`] keeps (a request makes at most two), and
+/// solves of the whole input (each holds a map of every face).
 const KEPT_DECIMATIONS: usize = 2;
+const KEPT_FULL: usize = 2;
 
 impl QuadStage {
     /// The stage of an input with `features`.
@@ -271,6 +274,9 @@ impl QuadStage {
             None => {
                 let options = self.solve_options(input, grid);
                 let solution = solve(input, &features.all, &options, &mut |p| progress(QuadProgress::Solve(p))).map_err(QuadsError::Solve)?;
+                if self.full.len() == KEPT_FULL {
+                    self.full.pop();
+                }
                 self.full.push(GridStage::new(solution, features.clone(), options, LongEdges::RefineFirst));
                 self.full.len() - 1
             }
