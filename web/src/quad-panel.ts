@@ -331,8 +331,12 @@ function quadTable(s: Shown, counts: ReturnType<typeof valenceCounts>): HTMLDLis
   } else if (s.result.refinement.long_edges > 0) {
     rows.push(['Solved on', `${fmtInt(s.result.solved_faces)} triangles (long edges split for quads)`]);
   }
+  rows.push(['Defects (repaired)', fmtInt(s.result.defects)]);
+  if (decimated) {
+    const t = s.result.timings;
+    rows.push(['Time: decimation and its solve', fmtMs((t.decimate + t.solve) * 1000)]);
+  }
   rows.push(
-    ['Defects (repaired)', fmtInt(s.result.defects)],
     ['Time: quantization', fmtMs(q.seconds * 1000)],
     ['Time: quads request', fmtMs(s.ms)],
   );
