@@ -3,9 +3,12 @@
 //! ([`extract_quads_along`]) and their figures against the input
 //! ([`check_quads`]). A mesh much finer than its quads is traced on a
 //! decimation ([`Coarse`]) and the quads moved onto the input
-//! ([`project_onto`]); where those quads fold they are traced again on a
-//! decimation twice as fine (on the input below twice that), and the
-//! better quads are kept. [`QuadStage`] keeps its solves for the next grid
+//! ([`project_onto`]); where those quads fold, or their Euler
+//! characteristic or boundary loops are not the input's, they are traced
+//! again on a decimation twice as fine (on the input below twice that),
+//! and the better quads are kept (the input's topology first, then fewer
+//! folds, then nearer the input; measured in `docs/STATUS.md`, sessions
+//! 43 and 44). [`QuadStage`] keeps its solves for the next grid
 //! (the page's quad-count slider re-runs only the quantization where the
 //! mesh is solved whole, and the decimation's solve where it is not).
 
@@ -197,7 +200,8 @@ impl QuadStage {
     /// The quads of `input` (the mesh the stage's features are of) for
     /// `grid`: on a decimation where `input` has more than twice
     /// [`COARSE_FACES_PER_QUAD`] faces per quad, with the fallbacks of the
-    /// module doc; on `input` otherwise.
+    /// module doc (a retry where those quads fold or have another topology
+    /// than `input`); on `input` otherwise.
     pub fn quads(&mut self, input: &TriMesh, grid: GridSize, progress: &mut dyn FnMut(QuadProgress)) -> Result<TracedQuads, QuadsError> {
         let all = self.features.clone();
         let first = match self.trace_coarse(input, &all, grid, COARSE_FACES_PER_QUAD, progress) {
@@ -210,7 +214,7 @@ impl QuadStage {
             }
             None => return self.trace_full(input, &all, grid, progress),
         };
-        if first.folds() == 0 {
+        if first.folds() == 0 && !first.topology_differs(input) {
             return Ok(first);
         }
         // With the features the first kept, none dropped again: one solve
