@@ -37,7 +37,7 @@ pub enum QuadProgress {
     /// Decimating the input (faces per quad asked for).
     Decimate { faces_per_quad: f64 },
     Solve(SolveProgress),
-    /// A quantization's rounding: places done of total.
+    /// A quantization's rounding: integers rounded of those to round.
     Quantize { done: usize, total: usize },
     Extract,
 }
