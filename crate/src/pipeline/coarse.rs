@@ -60,7 +60,7 @@ impl Coarse {
             return None;
         }
         let quad = quad_length(input, grid);
-        let quads = input.face_areas().iter().sum::<f64>() / (quad * quad);
+        let quads = quads_on(input, quad);
         let mut keep = vec![false; input.n_vertices()];
         for e in features.edges() {
             for v in input.edge_vertices(e) {
@@ -87,8 +87,7 @@ impl Coarse {
     /// Whether `input` has more than twice `faces_per_quad` faces per quad
     /// of `grid` ([`Coarse::for_quads`] decimates it).
     pub fn wanted(input: &TriMesh, grid: GridSize, faces_per_quad: f64) -> bool {
-        let quad = quad_length(input, grid);
-        let quads = input.face_areas().iter().sum::<f64>() / (quad * quad);
+        let quads = quads_on(input, quad_length(input, grid));
         quads.is_finite() && quads > 0.0 && (input.n_faces() as f64) > 2.0 * faces_per_quad * quads
     }
 
@@ -127,6 +126,11 @@ impl Coarse {
         }
         out
     }
+}
+
+/// How many quads of edge `quad` cover `mesh`'s area.
+fn quads_on(mesh: &TriMesh, quad: f64) -> f64 {
+    mesh.face_areas().iter().sum::<f64>() / (quad * quad)
 }
 
 /// Per face corner of `onto`, the value of the piecewise linear per-corner

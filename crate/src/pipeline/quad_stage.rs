@@ -270,11 +270,11 @@ impl QuadStage {
             }
             self.coarse.push(CoarseSolve { key: key.clone(), coarse, stage });
         }
-        let (options, sharp) = (self.options, &self.features.all);
+        let (quantize, sharp) = (self.options.quantize, &self.features.all);
         let CoarseSolve { coarse, stage, .. } = self.coarse.iter_mut().find(|c| c.key == key).expect("kept above");
         let spent = timings.decimate + timings.solve;
         let Some(stage) = stage else { return Some(Err(spent)) };
-        let traced = trace(input, Some(coarse), stage, sharp, grid, &options, progress);
+        let traced = trace(input, Some(coarse), stage, sharp, grid, &quantize, progress);
         Some(traced.map(|t| TracedQuads { timings: QuadTimings { decimate: timings.decimate, solve: timings.solve, ..t.timings }, ..t }).map_err(|_| spent))
     }
 
@@ -295,8 +295,8 @@ impl QuadStage {
             }
         };
         let solve = clock.lap();
-        let options = self.options;
-        let mut traced = trace(input, None, &mut self.full[at], &self.features.all, grid, &options, progress)?;
+        let quantize = self.options.quantize;
+        let mut traced = trace(input, None, &mut self.full[at], &self.features.all, grid, &quantize, progress)?;
         traced.timings.solve = solve;
         Ok(traced)
     }
@@ -318,7 +318,7 @@ fn trace(
     stage: &mut GridStage,
     sharp: &FeatureSet,
     grid: GridSize,
-    options: &QuadOptions,
+    quantize: &QuantizeOptions,
     progress: &mut dyn FnMut(QuadProgress),
 ) -> Result<TracedQuads, QuadsError> {
     let mut clock = Stopwatch::start();
@@ -327,10 +327,10 @@ fn trace(
         let progress = std::cell::RefCell::new(&mut *progress);
         let solving = &mut |p| (progress.borrow_mut())(QuadProgress::Solve(p));
         let quantizing = &mut |done, total| (progress.borrow_mut())(QuadProgress::Quantize { done, total });
-        stage.map(mesh, grid, &options.quantize, solving, quantizing)
+        stage.map(mesh, grid, quantize, solving, quantizing)
     };
     let GridMapped { solution, map, dropped_features, cancelled_pairs } = mapped.map_err(QuadsError::Quantize)?;
-    let quantize = clock.lap();
+    let quantize_seconds = clock.lap();
     progress(QuadProgress::Extract);
     // On a decimation, the quads are untangled once they are on the input.
     let extract_options = ExtractOptions { untangle: coarse.is_none(), ..ExtractOptions::default() };
@@ -338,7 +338,8 @@ fn trace(
     let (dropped_features, decimation) = match coarse {
         Some(c) => {
             let largest_projection = project_onto(&mut quads, &solution.mesh, input, sharp);
-            (c.input_features(input, &dropped_features), Some(largest_projection))
+            let decimation = Decimation { faces: c.mesh.n_faces(), vertices: c.mesh.n_vertices(), largest_projection };
+            (c.input_features(input, &dropped_features), Some(decimation))
         }
         None => (dropped_features, None),
     };
@@ -358,9 +359,9 @@ fn trace(
         cancelled_pairs,
         quads,
         report,
-        decimation: coarse.zip(decimation).map(|(c, largest_projection)| Decimation { faces: c.mesh.n_faces(), vertices: c.mesh.n_vertices(), largest_projection }),
+        decimation,
         attempts: Attempts::Once,
         traced: 1,
-        timings: QuadTimings { decimate: 0.0, solve: 0.0, quantize, extract, check },
+        timings: QuadTimings { decimate: 0.0, solve: 0.0, quantize: quantize_seconds, extract, check },
     })
 }

@@ -22,7 +22,6 @@ use crate::TriMesh;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-
 /// What [`check_quads`] measures beyond the figures it always computes.
 #[derive(Clone, Copy, Debug)]
 pub struct CheckOptions<'a> {
