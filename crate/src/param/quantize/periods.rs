@@ -22,7 +22,7 @@
 //! rounded forms determine a tube period at fewer than [`TUBE_STEPS`] steps,
 //! [`Quantizer::widen_periods`] moves the integers that determine it.
 
-use super::fit::RoundedSystem;
+use super::fit::{RoundedSystem, Trials};
 use super::rounding::distance_to_integer;
 use super::super::separation::Separations;
 use super::{corner_angle_sums, QuantizeError, Quantizer, NEAR_INTEGER};
@@ -137,8 +137,8 @@ impl Quantizer {
     /// [`TUBE_STEPS`] steps: as [`Self::separate`] does for separations, the
     /// period's change per unit change of every rounded integer from one
     /// adjoint solve, then the integers that widen it, closest to their
-    /// seamless values first, tried moved (each one solve with the same
-    /// factorization); a move is kept when every form stays integer, the
+    /// seamless values first, tried moved (each from the moved row's
+    /// response, [`RoundedSystem::response`]); a move is kept when every form stays integer, the
     /// period gains and no more separations are violated. At most
     /// [`Self::budget`]`(PERIOD_TRIALS)` solves. Returns the moves kept.
     pub(super) fn widen_periods(
@@ -156,19 +156,19 @@ impl Quantizer {
                 trials += 1;
                 let (steps_before, violated_before) = (steps(period.value(&system.x)), separations.violated(&system.x, NEAR_INTEGER).len());
                 let mut kept = false;
-                for (_, form, row, step) in candidates.into_iter().take(CANDIDATES_PER_PERIOD) {
-                    if trials >= max_trials {
-                        break;
-                    }
+                let mut candidates = candidates;
+                candidates.truncate(CANDIDATES_PER_PERIOD.min(max_trials.saturating_sub(trials)));
+                let mut ahead = Trials::new(candidates.iter().map(|c| c.2));
+                for (i, (_, form, row, step)) in candidates.into_iter().enumerate() {
                     trials += 1;
-                    let x = system.resolve_moved(self, targets, row, step)?;
+                    let x = ahead.resolve_moved(system, i, step)?;
                     let mut trial = values.to_vec();
                     trial[form] = values[form].map(|v| v + step);
                     if self.rounded_forms_integral(&trial, &x)
                         && steps(period.value(&x)) > steps_before
                         && separations.violated(&x, NEAR_INTEGER).len() <= violated_before
                     {
-                        system.take_move(row, step, x);
+                        system.take_move(self, targets, row, step)?;
                         values.copy_from_slice(&trial);
                         self.take_determined_values(values, &system.x);
                         (moves, kept) = (moves + 1, true);

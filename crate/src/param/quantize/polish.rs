@@ -9,7 +9,7 @@ use super::super::element::signed_uv_area;
 use super::super::seamless::{closest_rotation, stiffness_triplets};
 use super::super::separation::Separations;
 use super::super::untangle::{untangle, UntangleOptions, UntangleStats};
-use super::fit::{precondition, RoundedSystem};
+use super::fit::{precondition, RoundedSystem, Trials};
 use super::{corner_angle_sums, local, QuantizeError, Quantizer, FULL_BUDGET_FACES, NEAR_INTEGER};
 use crate::linalg::{Kkt, LdltSolver, NullSpaceProjector};
 use std::f64::consts::{FRAC_PI_4, PI};
@@ -277,8 +277,8 @@ impl Quantizer {
     /// adjoint solves as in [`Self::separate`], so a translation whose seam
     /// passes there counts too), closest to their seamless values first,
     /// keeping each move that leaves a less bad map ([`Self::badness`]) and
-    /// no more violated separations, every form still integer. One solve
-    /// with `system`'s factorization per trial, at most
+    /// no more violated separations, every form still integer. Each trial
+    /// from the moved row's response ([`RoundedSystem::response`]), at most
     /// [`UNCOLLAPSE_TRIALS`]. Returns the moves kept.
     pub(super) fn uncollapse(
         &self,
@@ -322,21 +322,22 @@ impl Quantizer {
                 })
                 .collect();
             candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+            candidates.retain(|&(_, form, _, step)| !tried.contains(&(form, values[form].unwrap_or(0) + step)));
+            candidates.truncate(max_trials - trials);
+            let mut ahead = Trials::new(candidates.iter().map(|c| c.2));
             let mut improved = false;
-            for (_, form, row, step) in candidates {
+            for (i, (_, form, row, step)) in candidates.into_iter().enumerate() {
                 let v = values[form].unwrap_or(0) + step;
-                if trials >= max_trials || !tried.insert((form, v)) {
-                    continue;
-                }
+                tried.insert((form, v));
                 trials += 1;
-                let moved = system.resolve_moved(self, targets, row, step)?;
+                let moved = ahead.resolve_moved(system, i, step)?;
                 let after = self.badness(&moved, s);
                 if self.rounded_forms_integral(values, &moved) && after < badness && separations.violated(&moved, NEAR_INTEGER).len() <= violated {
                     values[form] = Some(v);
-                    self.take_determined_values(values, &moved);
-                    x.clone_from(&moved);
-                    system.take_move(row, step, moved);
-                    badness = after;
+                    system.take_move(self, targets, row, step)?;
+                    self.take_determined_values(values, &system.x);
+                    x.clone_from(&system.x);
+                    badness = self.badness(x, s);
                     kept += 1;
                     improved = true;
                     break;

@@ -5,8 +5,8 @@
 //! periods widened the same way ([`Quantizer::widen_periods`]); then the
 //! polish ([`super::polish`]).
 
-use super::super::separation::{HeldApart, Separation, Separations};
-use super::fit::{Fit, RoundedSystem};
+use super::super::separation::{HeldApart, Separations};
+use super::fit::{Fit, RoundedSystem, Trials};
 use super::forms::FormKind;
 use super::polish::Polished;
 use super::{GridStart, Pass, QuantizeError, Quantizer, Rounded, FULL_BUDGET_FACES, NEAR_INTEGER};
@@ -293,7 +293,7 @@ impl Quantizer {
     /// from one adjoint solve (`K⁻¹ [c; 0]`, the multipliers), and
     /// the integers that widen it, closest to their seamless values first,
     /// are tried moved by one (by two where the gap gains a half per unit),
-    /// each re-solved with the same factorization. A
+    /// each from the moved row's response ([`RoundedSystem::response`]). A
     /// move is kept when every form stays integer and fewer separations stay
     /// violated; when none does, the cheapest move that mends one pair at
     /// the price of another is taken (at most [`SIDEWAYS_MOVES`], never back
@@ -322,44 +322,46 @@ impl Quantizer {
                     break 'pairs;
                 }
                 trials += 1;
-                let candidates = self.widening_moves(system, &[(sep.hi, 1), (sep.lo, -1)], values, x0)?;
-                for &(_, form, row, step) in candidates.iter().take(CANDIDATES_PER_SEPARATION) {
-                    if trials >= max_trials {
-                        break 'pairs;
-                    }
+                let moved_values = |form: usize, step: i64| {
                     let mut trial = values.to_vec();
                     trial[form] = Some(values[form].unwrap_or(0) + step);
-                    if seen.contains(&trial) {
-                        continue;
-                    }
+                    trial
+                };
+                let mut candidates = self.widening_moves(system, &[(sep.hi, 1), (sep.lo, -1)], values, x0)?;
+                candidates.truncate(CANDIDATES_PER_SEPARATION);
+                candidates.retain(|&(_, form, _, step)| !seen.contains(&moved_values(form, step)));
+                candidates.truncate(max_trials - trials);
+                let mut ahead = Trials::new(candidates.iter().map(|c| c.2));
+                for (i, &(_, form, row, step)) in candidates.iter().enumerate() {
+                    let trial = moved_values(form, step);
                     trials += 1;
-                    let x = system.resolve_moved(self, targets, row, step)?;
+                    let x = ahead.resolve_moved(system, i, step)?;
                     if !self.rounded_forms_integral(&trial, &x) {
                         continue;
                     }
                     let after = separations.violated(&x, NEAR_INTEGER);
                     if after.len() < violated.len() {
-                        best = Some(SeparationMove { row, step, x, values: trial, violated: after });
+                        best = Some(SeparationMove { row, step, values: trial });
                         improved = true;
                         break 'pairs;
                     }
                     if best.is_none() && after.len() == violated.len() && !after.contains(&sep) {
-                        best = Some(SeparationMove { row, step, x, values: trial, violated: after });
+                        best = Some(SeparationMove { row, step, values: trial });
                     }
                 }
             }
-            let Some(SeparationMove { row, step, x, values: trial, violated: after }) = best else { break };
+            let Some(SeparationMove { row, step, values: trial }) = best else { break };
             if !improved {
                 if sideways == SIDEWAYS_MOVES {
                     break;
                 }
                 sideways += 1;
             }
-            system.take_move(row, step, x);
+            system.take_move(self, targets, row, step)?;
             values.copy_from_slice(&trial);
             self.take_determined_values(values, &system.x);
             seen.insert(values.to_vec());
-            violated = after;
+            violated = separations.violated(&system.x, NEAR_INTEGER);
             moves += 1;
         }
         Ok(moves)
@@ -427,8 +429,7 @@ impl Quantizer {
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             let Some((_, form, row, step)) = best else { break };
             values[form] = values[form].map(|v| v + step);
-            let x = system.resolve_moved(self, targets, row, step)?;
-            system.take_move(row, step, x);
+            system.take_move(self, targets, row, step)?;
         }
         Ok(())
     }
@@ -449,8 +450,8 @@ impl Quantizer {
     /// `system.x`, its gap's change per unit change of every held row comes
     /// from one adjoint solve ([`RoundedSystem::sensitivity`]); the held
     /// rows that widen it, least stretched first, are tried a line wider
-    /// (two where it gains a half per line), each one solve with the same
-    /// factorization; a trial is kept when fewer held pairs stay violated.
+    /// (two where it gains a half per line), each from the row's response
+    /// ([`RoundedSystem::response`]); a trial is kept when fewer held pairs stay violated.
     /// At most [`Self::budget`]`(WIDEN_TRIALS)` solves. Returns the rows widened.
     pub(super) fn widen_held(&self, system: &mut RoundedSystem, held: &mut HeldApart, x0: &[f64], targets: &[[[f64; 2]; 2]]) -> Result<usize, QuantizeError> {
         let mut violated = held.violated(&system.x, NEAR_INTEGER);
@@ -476,16 +477,15 @@ impl Quantizer {
                 })
                 .collect();
             candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            for (_, k, row, step) in candidates.into_iter().take(CANDIDATES_PER_SEPARATION) {
-                if trials >= max_trials {
-                    break;
-                }
+            candidates.truncate(CANDIDATES_PER_SEPARATION.min(max_trials - trials));
+            let mut ahead = Trials::new(candidates.iter().map(|c| c.2));
+            for (i, (_, k, row, step)) in candidates.into_iter().enumerate() {
                 trials += 1;
-                let x = system.resolve_moved(self, targets, row, step)?;
+                let x = ahead.resolve_moved(system, i, step)?;
                 let after = held.violated(&x, NEAR_INTEGER);
                 if after.len() < violated.len() {
-                    system.take_move(row, step, x);
-                    violated = after;
+                    system.take_move(self, targets, row, step)?;
+                    violated = held.violated(&system.x, NEAR_INTEGER);
                     held.gaps[k] += step;
                     widened += 1;
                     break;
@@ -504,14 +504,11 @@ pub(super) struct SizeRules {
 }
 
 /// One integer moved by [`Quantizer::separate`]: the row of `c` changed by
-/// `step`, the re-solved map, the forms' values and the separations still
-/// violated.
+/// `step` and the forms' values.
 pub(super) struct SeparationMove {
     pub(super) row: usize,
     pub(super) step: i64,
-    pub(super) x: Vec<f64>,
     pub(super) values: Vec<Option<i64>>,
-    pub(super) violated: Vec<Separation>,
 }
 
 /// The change of a row's value that widens a gap by a grid line, from the
