@@ -354,7 +354,7 @@ export interface QuadsResult {
   /** Cones of the map quantized, and the pairs of opposite cones of the solve cancelled for this grid (closer than a cell's diagonal; 0 on a map solved without dropped features, which cancels its own). */
   cones: number;
   cancelled_pairs: number;
-  /** Input feature edges the map was solved without: the map with them folded and the grid is too coarse to follow them (0: every feature kept). */
+  /** Input feature edges the map was solved without: the map with them folded, and the grid is too coarse to follow them or they ran next to the folds (0: every feature kept). */
   dropped_feature_edges: number;
   /** Of those, the edges marked as creases (the map with them folded on their part of the mesh). */
   dropped_crease_edges: number;

@@ -794,7 +794,7 @@ fn print_dropped_features(features: &GridFeatures, dropped: &FeatureSet) {
     let asked = dropped.without(detected).len();
     if asked > 0 {
         println!(
-            "  note: the map with every feature folds; solved without {asked} feature edges the grid is too coarse to follow (branches and loops under {} quads); a smaller grid keeps them",
+            "  note: the map with every feature folds; solved without {asked} feature edges: those the grid is too coarse to follow (branches and loops under {} quads), then those next to the folds; a smaller grid keeps more of them",
             conemap::features::grid::MIN_CURVE_CELLS
         );
     }

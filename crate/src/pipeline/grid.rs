@@ -85,11 +85,9 @@ pub struct GridStage {
     long_edges: LongEdges,
     /// The map solved again with these cut-vertex pairs of `base` cancelled.
     paired: Option<Resolved<Vec<(u32, u32)>>>,
-    /// The map solved again without these feature edges (step 3 of
-    /// [`GridStage::map`]): without the detected creases next to the folds
-    /// (`local`), and without all those of the folding parts.
-    local: Option<Resolved<FeatureSet>>,
-    unfollowed: Option<Resolved<FeatureSet>>,
+    /// The maps solved again without these feature edges (steps 3 and 4
+    /// of [`GridStage::map`]), by [`Without`].
+    without: [Option<Resolved<FeatureSet>>; 4],
 }
 
 /// A map and its quantizer (set up on first use).
@@ -110,8 +108,19 @@ struct Resolved<K> {
 enum Source {
     Base,
     Paired,
-    Local,
-    Unfollowed,
+    Without(Without),
+}
+
+/// Which feature curves a map solved again without features dropped
+/// ([`GridStage::map`], steps 3 and 4), besides the curves finer than the
+/// grid: the detected creases' chains next to the folds, every detected
+/// crease of the folding components, then the same of the asked features.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Without {
+    DetectedNear = 0,
+    Detected = 1,
+    AskedNear = 2,
+    Asked = 3,
 }
 
 impl Solved {
@@ -141,7 +150,7 @@ impl GridStage {
     pub fn new(solution: Solution<'_>, features: GridFeatures, options: SolveOptions, long_edges: LongEdges) -> GridStage {
         // As solved: a low-poly fallback's edge length is not asked again.
         let options = SolveOptions { refine: solution.refine_options, ..options };
-        GridStage { base: Solved::new(solution.into_owned()), features, options, long_edges, paired: None, local: None, unfollowed: None }
+        GridStage { base: Solved::new(solution.into_owned()), features, options, long_edges, paired: None, without: Default::default() }
     }
 
     /// The features solved for (every one, the dropped ones too).
@@ -183,7 +192,14 @@ impl GridStage {
     ///    map ([`QuantizeOptions::plain_only_if_hopeless`]: bff-face with
     ///    creases above 60° at 1 000 quads, about 500 -> 67 s for the same
     ///    quads), and runs its other passes only where the map without them
-    ///    folds no less.
+    ///    folds no less;
+    /// 4. where it still folds, solved again without the asked features'
+    ///    chains next to the folds too, then without every feature of the
+    ///    components where it folds, each kept if it folds less: a folded
+    ///    map follows no curve cleanly, and its quads have holes and
+    ///    overlaps (cow with creases above 60° at 1 000 quads: 151 defects
+    ///    and 59 flipped triangles with the 114 of its 302 edges that step
+    ///    3 keeps).
     ///
     /// A failed solve in 2 or 3 keeps the map without it. Errors: the
     /// quantization's, of the map solved first. `solve_progress` reports
@@ -206,10 +222,12 @@ impl GridStage {
             }
         }
         // 2. Close cone pairs cancelled; with curves to drop, a hopeless
-        // first rounding stops after its plain pass.
+        // rounding stops after its plain pass where a later step may drop
+        // more (the first, and those of 3 and 4 that asked features may
+        // follow).
         let source = self.pair_cancelled(input, size, solve_progress);
         let mut dropped = finer_than_grid(input, &self.features.all, quad_length(input, size));
-        let droppable = !dropped.is_empty() || !self.features.detected.is_empty();
+        let droppable = !self.features.all.is_empty();
         let first = QuantizeOptions { plain_only_if_hopeless: droppable, ..*quantize };
         let map = self.quantize(source, size, &first, progress)?;
         let mut best = Candidate { source, map, dropped: FeatureSet::none(input) };
@@ -234,23 +252,34 @@ impl GridStage {
             // First only the detected creases' chains next to the folds,
             // kept where that map does not fold.
             let mut local = dropped.clone();
-            local.union(&self.detected_near_folds(input, &best));
-            dropped.union(&self.detected_where_folded(input, &best));
+            local.union(&self.near_folds(input, &best, &self.features.detected));
+            dropped.union(&self.where_folded(input, &best, &self.features.detected));
             if !local.is_empty() && local != dropped {
-                self.solve_without(|s| &mut s.local, &local, input, size, solve_progress);
-                if let Ok(map) = self.quantize(Source::Local, size, quantize, progress) {
-                    if map.report.folds() == 0 {
-                        best = Candidate { source: Source::Local, map, dropped: local };
-                    }
-                }
+                self.try_without(Without::DetectedNear, local, &mut best, true, input, size, quantize, solve_progress, progress);
             }
         }
+        let asked = self.features.all != self.features.detected;
         if best.map.report.folds() > 0 && !dropped.is_empty() {
-            self.solve_without(|s| &mut s.unfollowed, &dropped, input, size, solve_progress);
-            if let Ok(map) = self.quantize(Source::Unfollowed, size, quantize, progress) {
-                if map.report.folds() < best.map.report.folds() {
-                    best = Candidate { source: Source::Unfollowed, map, dropped };
-                }
+            let options = if asked { &first } else { quantize };
+            self.try_without(Without::Detected, dropped.clone(), &mut best, false, input, size, options, solve_progress, progress);
+        }
+        // 4. Where it still folds, the asked features next to the folds, then
+        // every feature of the folding components, go too: a folded map
+        // follows no curve cleanly, and its quads have holes and overlaps
+        // (cow with creases above 60° at 1 000 quads: 151 defects with
+        // the 114 edges left of 302).
+        if best.map.report.folds() > 0 && asked {
+            let mut local = dropped.clone();
+            local.union(&self.near_folds(input, &best, &self.features.all));
+            if local != best.dropped {
+                self.try_without(Without::AskedNear, local, &mut best, false, input, size, &first, solve_progress, progress);
+            }
+        }
+        if best.map.report.folds() > 0 && asked {
+            let mut all = dropped;
+            all.union(&self.where_folded(input, &best, &self.features.all));
+            if all != best.dropped {
+                self.try_without(Without::Asked, all, &mut best, false, input, size, quantize, solve_progress, progress);
             }
         }
         // A stopped rounding kept after all runs in full.
@@ -269,10 +298,36 @@ impl GridStage {
         Ok(GridMapped { solution, map: best.map, dropped_features: best.dropped, cancelled_pairs })
     }
 
-    /// The detected creases ([`GridFeatures::detected`]) on the components
-    /// of `input` where `candidate`'s map folds.
-    fn detected_where_folded(&self, input: &TriMesh, candidate: &Candidate) -> FeatureSet {
-        on_components_of(input, self.input_fold_faces(candidate).into_iter(), &self.features.detected)
+    /// The edges of `features` on the components of `input` where
+    /// `candidate`'s map folds.
+    fn where_folded(&self, input: &TriMesh, candidate: &Candidate, features: &FeatureSet) -> FeatureSet {
+        on_components_of(input, self.input_fold_faces(candidate).into_iter(), features)
+    }
+
+    /// The map solved again without the feature edges `dropped` (into slot
+    /// `without`) and quantized for `size`, made `best` where it folds less
+    /// (with `only_clean`, only where it does not fold at all).
+    #[allow(clippy::too_many_arguments)]
+    fn try_without(
+        &mut self,
+        without: Without,
+        dropped: FeatureSet,
+        best: &mut Candidate,
+        only_clean: bool,
+        input: &TriMesh,
+        size: GridSize,
+        quantize: &QuantizeOptions,
+        solve_progress: &mut dyn FnMut(SolveProgress),
+        progress: &mut dyn FnMut(usize, usize),
+    ) {
+        self.solve_without(without, &dropped, input, size, solve_progress);
+        let source = Source::Without(without);
+        if let Ok(map) = self.quantize(source, size, quantize, progress) {
+            let folds = map.report.folds();
+            if folds == 0 || (!only_clean && folds < best.map.report.folds()) {
+                *best = Candidate { source, map, dropped };
+            }
+        }
     }
 
     /// The faces of the input where `candidate`'s map folds (its solve's
@@ -282,9 +337,9 @@ impl GridStage {
         candidate.map.fold_faces.iter().map(|&f| solution.original_face.as_ref().map_or(f, |original| original[f as usize])).collect()
     }
 
-    /// The chains of the detected creases ([`chains_near`]) within a ring
-    /// of the faces where `candidate`'s map folds.
-    fn detected_near_folds(&self, input: &TriMesh, candidate: &Candidate) -> FeatureSet {
+    /// The chains of `features` ([`chains_near`]) within a ring of the
+    /// faces where `candidate`'s map folds.
+    fn near_folds(&self, input: &TriMesh, candidate: &Candidate, features: &FeatureSet) -> FeatureSet {
         let mut near = vec![false; input.n_vertices()];
         for f in self.input_fold_faces(candidate) {
             for v in input.faces()[f as usize] {
@@ -294,7 +349,7 @@ impl GridStage {
                 }
             }
         }
-        chains_near(input, &self.features.detected, &near)
+        chains_near(input, features, &near)
     }
 
     /// The map to round for `size` (step 2 of [`Self::map`]): the map solved
@@ -321,20 +376,13 @@ impl GridStage {
         }
     }
 
-    /// Fills `slot` (`local` or `unfollowed`) with the map solved again for
-    /// `size` without the feature edges `dropped`, unless it holds that
-    /// map (or its failed solve) already.
-    fn solve_without(
-        &mut self,
-        slot: fn(&mut GridStage) -> &mut Option<Resolved<FeatureSet>>,
-        dropped: &FeatureSet,
-        input: &TriMesh,
-        size: GridSize,
-        solve_progress: &mut dyn FnMut(SolveProgress),
-    ) {
-        if slot(self).as_ref().is_none_or(|r| &r.key != dropped) {
+    /// Fills slot `without` with the map solved again for `size` without
+    /// the feature edges `dropped`, unless it holds that map (or its failed
+    /// solve) already.
+    fn solve_without(&mut self, without: Without, dropped: &FeatureSet, input: &TriMesh, size: GridSize, solve_progress: &mut dyn FnMut(SolveProgress)) {
+        if self.without[without as usize].as_ref().is_none_or(|r| &r.key != dropped) {
             let solved = self.solve_again(input, &self.features.all.without(dropped), self.options.refine, Some(size), solve_progress);
-            *slot(self) = Some(Resolved { key: dropped.clone(), solved });
+            self.without[without as usize] = Some(Resolved { key: dropped.clone(), solved });
         }
     }
 
@@ -361,16 +409,14 @@ impl GridStage {
     fn replace_base(&mut self, solved: Solved) {
         self.base = solved;
         self.paired = None;
-        self.local = None;
-        self.unfollowed = None;
+        self.without = Default::default();
     }
 
     fn solved(&self, source: Source) -> Option<&Solved> {
         match source {
             Source::Base => Some(&self.base),
             Source::Paired => self.paired.as_ref()?.solved.as_ref(),
-            Source::Local => self.local.as_ref()?.solved.as_ref(),
-            Source::Unfollowed => self.unfollowed.as_ref()?.solved.as_ref(),
+            Source::Without(w) => self.without[w as usize].as_ref()?.solved.as_ref(),
         }
     }
 
@@ -379,8 +425,7 @@ impl GridStage {
         let solved = match source {
             Source::Base => Some(&mut self.base),
             Source::Paired => self.paired.as_mut().and_then(|p| p.solved.as_mut()),
-            Source::Local => self.local.as_mut().and_then(|u| u.solved.as_mut()),
-            Source::Unfollowed => self.unfollowed.as_mut().and_then(|u| u.solved.as_mut()),
+            Source::Without(w) => self.without[w as usize].as_mut().and_then(|u| u.solved.as_mut()),
         };
         let solved = solved.ok_or(QuantizeError::Mismatch { what: "a map that was not solved" })?;
         solved.quantize(size, options, progress)
