@@ -555,12 +555,8 @@ fn a_low_poly_cad_grid_map_is_solved_again_where_it_folds() {
 #[test]
 fn feature_curves_finer_than_the_grid_are_dropped_where_they_fold_the_map() {
     use conemap::features::finer_than_grid;
-    use conemap::pipeline::{quad_length, GridFeatures, GridStage, LongEdges, RefineOptions};
-    let input = load("teapot.obj");
-    let features = FeatureSet::sharp_edges(&input, 60.0);
-    let size = GridSize::Quads(3000);
-    let options = SolveOptions { refine: RefineOptions::for_quads(&input, size), ..SolveOptions::default() }.for_quads(&input, size);
-    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
+    use conemap::pipeline::{quad_length, GridFeatures, GridStage, LongEdges};
+    let (input, features, size, options, solution) = solved_with_sharp_features("teapot.obj", 60.0, 3000);
     let first = solution.quantizer().unwrap().quantize(&solution.mesh, size, &mut |_, _| {}).unwrap();
     assert!(first.report.folds() > 0, "the map with the lip no longer folds: this test no longer exercises the fallback");
     let finer = finer_than_grid(&input, &features, quad_length(&input, size));
@@ -579,6 +575,19 @@ fn feature_curves_finer_than_the_grid_are_dropped_where_they_fold_the_map() {
     let mut solves = 0;
     let again = stage.map(&input, size, &QuantizeOptions::default(), &mut |_| solves += 1, &mut |_, _| {}).unwrap();
     assert_eq!((solves, &again.dropped_features, &again.map.uv), (0, &finer, &uv));
+}
+
+/// Shared mesh `name`, its edges above `degrees` as asked features, the
+/// grid of about `quads` quads, and the settings and map `quads` solves
+/// them with.
+fn solved_with_sharp_features(name: &str, degrees: f64, quads: usize) -> (TriMesh, FeatureSet, GridSize, SolveOptions, conemap::pipeline::Solution<'static>) {
+    use conemap::pipeline::RefineOptions;
+    let input = load(name);
+    let features = FeatureSet::sharp_edges(&input, degrees);
+    let size = GridSize::Quads(quads);
+    let options = SolveOptions { refine: RefineOptions::for_quads(&input, size), ..SolveOptions::default() }.for_quads(&input, size);
+    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap().into_owned();
+    (input, features, size, options, solution)
 }
 
 /// The grid stage of shared mesh `name` solved with the creases
@@ -650,12 +659,8 @@ fn detected_creases_go_only_next_to_the_folds_where_that_unfolds_the_map() {
 #[test]
 fn asked_features_go_next_to_the_folds_where_the_map_still_folds() {
     use conemap::features::finer_than_grid;
-    use conemap::pipeline::{quad_length, GridFeatures, GridStage, LongEdges, RefineOptions};
-    let input = load("cow.obj");
-    let features = FeatureSet::sharp_edges(&input, 60.0);
-    let size = GridSize::Quads(3000);
-    let options = SolveOptions { refine: RefineOptions::for_quads(&input, size), ..SolveOptions::default() }.for_quads(&input, size);
-    let solution = solve(&input, &features, &options, &mut |_| {}).unwrap();
+    use conemap::pipeline::{quad_length, GridFeatures, GridStage, LongEdges};
+    let (input, features, size, options, solution) = solved_with_sharp_features("cow.obj", 60.0, 3000);
     let mut stage = GridStage::new(solution, GridFeatures::asked(&input, features.clone()), options, LongEdges::RefineFirst);
     let mapped = stage.map(&input, size, &QuantizeOptions::default(), &mut |_| {}, &mut |_, _| {}).unwrap();
     let finer = finer_than_grid(&input, &features, quad_length(&input, size));
