@@ -107,8 +107,9 @@
 //! first batch, and at most [`WIDEN_TRIALS`](rounding::WIDEN_TRIALS) solves widening). With that factorization:
 //! one adjoint solve per violated separation and one solve per row moved
 //! (its response, kept while the factorization is: a trial move is
-//! `x + step * response`; solved ahead in batches, [`fit::Trials`]; at most [`SEPARATION_TRIALS`](rounding::SEPARATION_TRIALS) per batch, fewer on large meshes:
-//! [`FULL_BUDGET_FACES`]), and the same per narrow tube period (at most
+//! `x + step * response`; solved ahead in batches, [`fit::Trials`]; at
+//! most [`SEPARATION_TRIALS`](rounding::SEPARATION_TRIALS) per batch, fewer
+//! on large meshes: [`FULL_BUDGET_FACES`]), and the same per narrow tube period (at most
 //! [`PERIOD_TRIALS`](periods::PERIOD_TRIALS) solves per batch); after the last batch, one
 //! adjoint solve per probed unknown and one response per `uncollapse` trial
 //! (at most [`UNCOLLAPSE_TRIALS`](polish::UNCOLLAPSE_TRIALS), only where the map is bad), and one solve

@@ -201,7 +201,7 @@ impl GridStage {
     ///    and 59 flipped triangles with the 114 of its 302 edges that step
     ///    3 keeps).
     ///
-    /// A failed solve in 2 or 3 keeps the map without it. Errors: the
+    /// A failed solve in 2, 3 or 4 keeps the map without it. Errors: the
     /// quantization's, of the map solved first. `solve_progress` reports
     /// the solves, `progress` each quantization.
     pub fn map(

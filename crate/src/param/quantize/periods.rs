@@ -138,8 +138,9 @@ impl Quantizer {
     /// period's change per unit change of every rounded integer from one
     /// adjoint solve, then the integers that widen it, closest to their
     /// seamless values first, tried moved (each from the moved row's
-    /// response, [`RoundedSystem::response`]); a move is kept when every form stays integer, the
-    /// period gains and no more separations are violated. At most
+    /// response, [`RoundedSystem::response`]); a move is kept when every
+    /// form stays integer, the period gains and no more separations are
+    /// violated. At most
     /// [`Self::budget`]`(PERIOD_TRIALS)` solves. Returns the moves kept.
     pub(super) fn widen_periods(
         &self,
@@ -152,11 +153,10 @@ impl Quantizer {
         let (mut moves, mut trials, max_trials) = (0, 0, self.budget(PERIOD_TRIALS));
         for period in &self.tube_periods {
             while period.violated(&system.x) && trials < max_trials {
-                let candidates = self.widening_moves(system, &period.widening_row(x0), values, x0)?;
+                let mut candidates = self.widening_moves(system, &period.widening_row(x0), values, x0)?;
                 trials += 1;
                 let (steps_before, violated_before) = (steps(period.value(&system.x)), separations.violated(&system.x, NEAR_INTEGER).len());
                 let mut kept = false;
-                let mut candidates = candidates;
                 candidates.truncate(CANDIDATES_PER_PERIOD.min(max_trials.saturating_sub(trials)));
                 let mut ahead = Trials::new(candidates.iter().map(|c| c.2));
                 for (i, (_, form, row, step)) in candidates.into_iter().enumerate() {

@@ -451,8 +451,8 @@ impl Quantizer {
     /// from one adjoint solve ([`RoundedSystem::sensitivity`]); the held
     /// rows that widen it, least stretched first, are tried a line wider
     /// (two where it gains a half per line), each from the row's response
-    /// ([`RoundedSystem::response`]); a trial is kept when fewer held pairs stay violated.
-    /// At most [`Self::budget`]`(WIDEN_TRIALS)` solves. Returns the rows widened.
+    /// ([`RoundedSystem::response`]); a trial is kept when fewer held pairs
+    /// stay violated. At most [`Self::budget`]`(WIDEN_TRIALS)` solves. Returns the rows widened.
     pub(super) fn widen_held(&self, system: &mut RoundedSystem, held: &mut HeldApart, x0: &[f64], targets: &[[[f64; 2]; 2]]) -> Result<usize, QuantizeError> {
         let mut violated = held.violated(&system.x, NEAR_INTEGER);
         let (mut trials, max_trials, mut widened) = (0, self.budget(WIDEN_TRIALS), 0);
